@@ -1,0 +1,226 @@
+"""Lagrange slave surfaces: P1/P2 lines, P1/P2 triangles, Q1/Q2 (9-node) and
+8-node serendipity quadrilaterals, tabulated through Basix.
+
+Nodes of each cell follow Basix's reference ordering (vertices, then edges, then
+the interior), which is the ordering DOLFINx uses for facet closures.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import basix
+import numpy as np
+import numpy.typing as npt
+
+from dolfinx_mortar.layout import NodeLayout
+from dolfinx_mortar.tabulation import Tabulation
+
+FloatArray = npt.NDArray[np.float64]
+
+_CELL_TYPES = {"interval": basix.CellType.interval,
+               "triangle": basix.CellType.triangle,
+               "quadrilateral": basix.CellType.quadrilateral}
+
+#: α of the transformed quadratic basis (Popp, Gitterle, Gee, Wall 2010;
+#: Wohlmuth, Popp, Gee, Wall 2012): Ñ_v = N_v + α Σ_{edges e ∋ v} N_e,
+#: Ñ_e = (1 - 2α) N_e. With α = 1/5 every Ñ has a positive integral on
+#: 6-node triangles (2A/15, A/5) and 8-node quads (A/20, A/5).
+QUADRATIC_TRANSFORM_ALPHA = 0.2
+
+
+class ReferenceLagrange:
+    """Nodal Lagrange basis on a reference facet, optionally transformed.
+
+    Parameters
+    ----------
+    cell
+        ``"interval"``, ``"triangle"`` or ``"quadrilateral"``.
+    degree
+        1 or 2.
+    serendipity
+        Use the 8-node serendipity quadrilateral instead of the 9-node one.
+    quadratic_transform
+        Apply the transformed quadratic basis (for quadratic triangles and
+        quads), which makes every ∫N_A positive so that the lumped and dual kinds
+        are defined.
+    """
+
+    def __init__(self, cell: str, degree: int, serendipity: bool = False,
+                 quadratic_transform: bool = False):
+        if cell not in _CELL_TYPES:
+            raise ValueError(f"unknown facet cell '{cell}'; expected one of "
+                             f"{sorted(_CELL_TYPES)}")
+        if degree not in (1, 2):
+            raise ValueError(f"Lagrange slave facets of degree {degree} are not "
+                             "supported (degree 1 or 2)")
+        if serendipity and (cell != "quadrilateral" or degree != 2):
+            raise ValueError("serendipity elements are the 8-node quadrilateral only")
+        self.cell = cell
+        self.cell_type = _CELL_TYPES[cell]
+        self.degree = degree
+        self.serendipity = serendipity
+        self.tdim = len(basix.topology(self.cell_type)) - 1
+        if serendipity:
+            self._element = basix.create_element(
+                basix.ElementFamily.serendipity, self.cell_type, 2,
+                basix.LagrangeVariant.legendre, basix.DPCVariant.legendre, False)
+            # Basix's serendipity dofs are moments; make the basis nodal at the
+            # vertices and edge midpoints.
+            nodes = self._serendipity_nodes()
+            V = self._element.tabulate(0, nodes)[0, :, :, 0]
+            self._to_nodal = np.linalg.inv(V)
+            self.nodes = nodes
+        else:
+            self._element = basix.create_element(
+                basix.ElementFamily.P, self.cell_type, degree,
+                basix.LagrangeVariant.equispaced, False)
+            self._to_nodal = None
+            self.nodes = self._element.points
+        self.num_functions = len(self.nodes)
+        self.transform = self._quadratic_transform() if quadratic_transform else None
+        names = {("interval", 1): "P1 line", ("interval", 2): "P2 line",
+                 ("triangle", 1): "P1 triangle", ("triangle", 2): "P2 (6-node) triangle",
+                 ("quadrilateral", 1): "Q1 quadrilateral",
+                 ("quadrilateral", 2): "Q2 (9-node) quadrilateral"}
+        self.name = ("8-node serendipity quadrilateral" if serendipity
+                     else names[(cell, degree)])
+        if quadratic_transform:
+            self.name += " with the transformed quadratic basis"
+
+    def _serendipity_nodes(self) -> FloatArray:
+        vertices = basix.geometry(self.cell_type)
+        edges = basix.topology(self.cell_type)[1]
+        mids = np.array([vertices[e].mean(axis=0) for e in edges])
+        return np.vstack([vertices, mids])
+
+    def _quadratic_transform(self) -> FloatArray:
+        if self.degree != 2 or self.cell == "interval":
+            raise ValueError("the transformed quadratic basis applies to quadratic "
+                             "triangles and quadrilaterals only")
+        if self.cell == "quadrilateral" and not self.serendipity:
+            raise ValueError("9-node quadrilaterals need no transformed basis: all "
+                             "their ∫N_A are positive")
+        nv = len(basix.geometry(self.cell_type))
+        edges = basix.topology(self.cell_type)[1]
+        a = QUADRATIC_TRANSFORM_ALPHA
+        T = np.eye(self.num_functions)
+        for k, edge in enumerate(edges):
+            T[nv + k, nv + k] = 1.0 - 2.0 * a
+            for v in edge:
+                T[nv + k, v] = a
+        return T
+
+    def tabulate(self, X: FloatArray, transformed: bool = True) -> tuple[FloatArray, FloatArray]:
+        """Values (n, nd) and reference gradients (n, tdim, nd) at points X.
+
+        The gradients are of the untransformed basis: they serve the geometry
+        map, which is always isoparametric in the standard basis.
+        """
+        t = self._element.tabulate(1, np.asarray(X, dtype=np.float64))[..., 0]
+        if self._to_nodal is not None:
+            t = t @ self._to_nodal
+        values, grads = t[0], np.moveaxis(t[1:], 0, 1)
+        if transformed and self.transform is not None:
+            values = values @ self.transform
+        return values, grads
+
+
+class LagrangeSurface:
+    """A slave surface made of Lagrange facets, given by arrays.
+
+    Parameters
+    ----------
+    cell
+        ``"interval"``, ``"triangle"`` or ``"quadrilateral"``.
+    degree
+        1 or 2.
+    x
+        Node coordinates, shape (nodes, gdim), with gdim > tdim.
+    cells
+        Local node indices of each facet in Basix ordering, shape (cells, nd).
+    layout
+        How the nodes are distributed; ``None`` means serial.
+    serendipity, quadratic_transform
+        See :class:`ReferenceLagrange`.
+    """
+
+    def __init__(self, cell: str, degree: int, x: npt.ArrayLike, cells: npt.ArrayLike,
+                 layout: Optional[NodeLayout] = None, serendipity: bool = False,
+                 quadratic_transform: bool = False):
+        self.reference = ReferenceLagrange(cell, degree, serendipity, quadratic_transform)
+        self.x = np.asarray(x, dtype=np.float64)
+        self.cells = np.asarray(cells, dtype=np.int64)
+        if self.x.ndim != 2 or self.x.shape[1] <= self.reference.tdim:
+            raise ValueError(f"node coordinates must have shape (nodes, gdim) with gdim > "
+                             f"{self.reference.tdim} for {cell} facets, got {self.x.shape}")
+        if self.cells.ndim != 2 or self.cells.shape[1] != self.reference.num_functions:
+            raise ValueError(f"{self.reference.name} cells need "
+                             f"{self.reference.num_functions} nodes each, got cells of "
+                             f"shape {self.cells.shape}")
+        if not np.all(np.isfinite(self.x)):
+            raise ValueError("node coordinates contain NaN or infinite values")
+        self.layout = layout or NodeLayout.serial(len(self.x))
+        if len(self.x) != self.layout.size_local:
+            raise ValueError(f"{len(self.x)} node coordinates for a layout of "
+                             f"{self.layout.size_local} local nodes")
+        if len(self.cells) and (self.cells.min() < 0 or self.cells.max() >= len(self.x)):
+            raise ValueError("cell node indices out of range")
+        self.description = self.reference.name
+        self.tdim = self.reference.tdim
+        self.gdim = self.x.shape[1]
+
+    @property
+    def num_elements(self) -> int:
+        return len(self.cells)
+
+    @property
+    def num_functions(self) -> int:
+        return self.layout.size_local
+
+    def default_quadrature_degree(self) -> int:
+        # Exact for L^e on affine facets; two more for curved quadratic ones.
+        return 2 * self.reference.degree + (2 if self.reference.degree > 1 else 0)
+
+    def tabulate_at(self, cells: npt.NDArray[np.int64],
+                    X: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Basis values, physical points and surface Jacobians at reference points.
+
+        ``X`` has shape (n, tdim): one reference point per entry of ``cells``.
+        """
+        X = np.asarray(X, dtype=np.float64).reshape(-1, self.tdim)
+        N, dN = self.reference.tabulate(X)
+        N_geo, _ = self.reference.tabulate(X, transformed=False)
+        coords = self.x[self.cells[cells]]  # (n, nd, gdim)
+        x = np.einsum("nk,nkg->ng", N_geo, coords)
+        J = np.einsum("ntk,nkg->ngt", dN, coords)
+        return N, x, _surface_measure(J)
+
+    def tabulate(self, quadrature_degree: Optional[int] = None) -> Tabulation:
+        """Basis values, weights·|J| and points at a Basix rule on every facet."""
+        q = quadrature_degree or self.default_quadrature_degree()
+        X, wq = basix.make_quadrature(self.reference.cell_type, q)
+        N, dN = self.reference.tabulate(X)
+        N_geo, _ = self.reference.tabulate(X, transformed=False)
+        coords = self.x[self.cells]  # (nc, nd, gdim)
+        points = np.einsum("qk,ckg->cqg", N_geo, coords)
+        J = np.einsum("qtk,ckg->cqgt", dN, coords)
+        measure = _surface_measure(J)
+        nc, nq = len(self.cells), len(X)
+        phi = np.broadcast_to(N, (nc, nq, N.shape[1]))
+        return Tabulation(phi=np.ascontiguousarray(phi), weights=measure * wq[None, :],
+                          points=points)
+
+    def locate(self, points):
+        """Lagrange surfaces take evaluation points as ``(cells, X_reference)``."""
+        cells, X = points
+        cells = np.asarray(cells, dtype=np.int64)
+        N, _, _ = self.tabulate_at(cells, X)
+        return cells, N
+
+
+def _surface_measure(J: FloatArray) -> FloatArray:
+    """sqrt(det(JᵀJ)) for Jacobians of shape (..., gdim, tdim)."""
+    G = np.einsum("...gi,...gj->...ij", J, J)
+    if G.shape[-1] == 1:
+        return np.sqrt(G[..., 0, 0])
+    return np.sqrt(np.linalg.det(G))

@@ -1,0 +1,178 @@
+"""Distribution of slave functions over MPI ranks, and the global operations on them.
+
+A :class:`NodeLayout` says which slave functions a rank owns and which it sees
+as ghosts (DOLFINx's convention: owned first, ghosts after, contiguous global
+ownership ranges). Everything that couples elements — summing element
+contributions at functions, the global mass matrix ``L`` and its factorization —
+goes through PETSc, so one code path serves a serial B-spline curve and a
+distributed DOLFINx facet surface.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+from petsc4py import PETSc
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+#: PETSc options prefix of the mass-matrix solver (override e.g. with
+#: ``-dolfinx_mortar_mass_pc_factor_mat_solver_type superlu_dist``).
+MASS_SOLVER_PREFIX = "dolfinx_mortar_mass_"
+
+
+class NodeLayout:
+    """Owned and ghost slave functions of this rank.
+
+    Parameters
+    ----------
+    comm
+        The communicator.
+    num_owned
+        Number of functions this rank owns (local indices 0..num_owned-1).
+    ghosts
+        Global indices of the ghost functions (local indices num_owned...).
+    """
+
+    def __init__(self, comm: MPI.Comm, num_owned: int, ghosts: npt.ArrayLike):
+        self.comm = comm
+        self.num_owned = int(num_owned)
+        self.ghosts = np.asarray(ghosts, dtype=np.int64)
+        self.offset = comm.scan(self.num_owned) - self.num_owned
+        self.size_global = comm.allreduce(self.num_owned)
+
+    @classmethod
+    def serial(cls, n: int) -> "NodeLayout":
+        """All of ``n`` functions on one rank (B-spline curves and surfaces)."""
+        return cls(MPI.COMM_SELF, n, np.zeros(0, dtype=np.int64))
+
+    @property
+    def size_local(self) -> int:
+        """Owned plus ghost functions."""
+        return self.num_owned + len(self.ghosts)
+
+    @property
+    def global_indices(self) -> IntArray:
+        """Global index of every local function."""
+        return np.concatenate([np.arange(self.offset, self.offset + self.num_owned,
+                                         dtype=np.int64), self.ghosts])
+
+    def _ghosted_vector(self) -> PETSc.Vec:
+        return PETSc.Vec().createGhost(self.ghosts.astype(PETSc.IntType),
+                                       size=(self.num_owned, PETSc.DECIDE),
+                                       comm=self.comm)
+
+    def sum_at_functions(self, cells: IntArray, element_values: FloatArray) -> FloatArray:
+        """Σ over all elements on all ranks of element values at each local function.
+
+        Parameters
+        ----------
+        cells
+            Local function indices of each element, shape (cells, functions).
+        element_values
+            Per-element values, shape (cells, functions).
+
+        Returns
+        -------
+        Totals at owned and ghost functions, shape (size_local,).
+        """
+        local = np.bincount(np.asarray(cells).ravel(),
+                            weights=np.asarray(element_values).ravel(),
+                            minlength=self.size_local)
+        return self.complete(local)
+
+    def complete(self, partial: FloatArray) -> FloatArray:
+        """Add partial values across ranks, then copy the totals to the ghosts."""
+        vec = self._ghosted_vector()
+        with vec.localForm() as lf:
+            lf.array[:] = partial
+        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with vec.localForm() as lf:
+            out = lf.array.copy()
+        vec.destroy()
+        return out
+
+    def vector(self, values: Optional[FloatArray] = None) -> PETSc.Vec:
+        """A distributed PETSc vector holding the owned part of ``values``."""
+        vec = PETSc.Vec().createMPI((self.num_owned, PETSc.DECIDE), comm=self.comm)
+        if values is not None:
+            vec.array[:] = values[: self.num_owned]
+        return vec
+
+    def to_local(self, vec: PETSc.Vec) -> FloatArray:
+        """Owned and ghost values of a distributed vector in this layout."""
+        ghosted = self._ghosted_vector()
+        ghosted.array[:] = vec.array_r
+        ghosted.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with ghosted.localForm() as lf:
+            out = lf.array.copy()
+        ghosted.destroy()
+        return out
+
+    def assemble_matrix(self, cells: IntArray, element_matrices: FloatArray) -> PETSc.Mat:
+        """Assemble element matrices into a distributed AIJ matrix.
+
+        Rows of functions that no element touches (possible when the layout is a
+        DOLFINx function space and the surface a part of its boundary) get a unit
+        diagonal, so the matrix stays invertible without renumbering the surface.
+        """
+        cells = np.asarray(cells, dtype=PETSc.IntType)
+        nc, nd = cells.shape
+        touches = self.sum_at_functions(cells, np.ones(cells.shape))
+        # Generous preallocation bound: each touching element adds at most nd
+        # columns. Off-rank contributions make an exact count costly.
+        bound = np.minimum(touches[: self.num_owned] * nd + 1, self.size_global)
+        bound = bound.astype(PETSc.IntType)
+        mat = PETSc.Mat().createAIJ(((self.num_owned, self.size_global),
+                                     (self.num_owned, self.size_global)),
+                                    nnz=(bound, bound), comm=self.comm)
+        mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        lgmap = PETSc.LGMap().create(self.global_indices.astype(PETSc.IntType),
+                                     comm=self.comm)
+        mat.setLGMap(lgmap, lgmap)
+        mat.setValuesLocalRCV(cells, cells,
+                              np.ascontiguousarray(element_matrices).reshape(nc, nd * nd),
+                              addv=PETSc.InsertMode.ADD_VALUES)
+        untouched = np.flatnonzero(touches[: self.num_owned] == 0).astype(PETSc.IntType)
+        for i in untouched:
+            mat.setValueLocal(i, i, 1.0, addv=PETSc.InsertMode.ADD_VALUES)
+        mat.assemble()
+        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        return mat
+
+
+class MassMatrixSolver:
+    """A sparse direct factorization of the global slave mass matrix ``L``.
+
+    ``L`` is never inverted densely (DESIGN.md §2). The default is a Cholesky
+    factorization by MUMPS; the PETSc options database can change it under the
+    prefix :data:`MASS_SOLVER_PREFIX`.
+    """
+
+    def __init__(self, layout: NodeLayout, matrix: PETSc.Mat):
+        self.layout = layout
+        self.matrix = matrix
+        ksp = PETSc.KSP().create(layout.comm)
+        ksp.setOperators(matrix)
+        ksp.setType("preonly")
+        ksp.getPC().setType("cholesky")
+        ksp.getPC().setFactorSolverType("mumps")
+        ksp.setOptionsPrefix(MASS_SOLVER_PREFIX)
+        ksp.setFromOptions()
+        ksp.setUp()
+        self.ksp = ksp
+        self._rhs = layout.vector()
+        self._sol = layout.vector()
+
+    def solve(self, rhs: FloatArray) -> FloatArray:
+        """Solve ``L x = rhs`` for local (owned + ghost) arrays; returns local ``x``."""
+        self._rhs.array[:] = rhs[: self.layout.num_owned]
+        self.ksp.solve(self._rhs, self._sol)
+        reason = self.ksp.getConvergedReason()
+        if reason < 0:
+            raise RuntimeError(f"the mass-matrix solve failed (KSP reason {reason})")
+        return self.layout.to_local(self._sol)

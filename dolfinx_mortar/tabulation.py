@@ -1,0 +1,43 @@
+"""Tabulated slave basis data: what every slave surface hands to the kernels."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+
+@dataclass(frozen=True)
+class Tabulation:
+    """Slave basis functions at the quadrature points of every element.
+
+    Attributes
+    ----------
+    phi
+        N_i(x_q) of the element's local functions, shape (cells, points, functions).
+    weights
+        Quadrature weight times the surface Jacobian |J|, shape (cells, points).
+    points
+        Physical quadrature points, shape (cells, points, gdim).
+    """
+
+    phi: npt.NDArray[np.float64]
+    weights: npt.NDArray[np.float64]
+    points: npt.NDArray[np.float64]
+
+    def values_of(self, f) -> npt.NDArray[np.float64]:
+        """Evaluate a callable ``f(x)`` at the quadrature points.
+
+        ``x`` has shape (gdim, n) as in DOLFINx interpolation, so ``x[0]`` is the
+        first coordinate. Returns shape (cells, points).
+        """
+        nc, nq, gdim = self.points.shape
+        x = self.points.reshape(-1, gdim).T
+        values = np.asarray(f(x), dtype=np.float64)
+        if values.shape != (nc * nq,):
+            raise ValueError(
+                f"the callable returned shape {values.shape}; expected ({nc * nq},) "
+                f"for {nc * nq} points given as x of shape {x.shape}")
+        if not np.all(np.isfinite(values)):
+            raise ValueError("the callable returned NaN or infinite values")
+        return values.reshape(nc, nq)

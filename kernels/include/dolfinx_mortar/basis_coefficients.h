@@ -1,0 +1,55 @@
+// Copyright (C) 2026 dolfinx_mortar developers
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "basis_kind.h"
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace dolfinx_mortar
+{
+
+/// Check that the lumped weights allow @p kind, relative to the element
+/// measure |e| = Σ_i W^e_i (the slave basis is a partition of unity).
+///
+/// The dual kinds (LcLS*, LcLS) need W^e_A > 0 on every element; the kinds
+/// that divide by or scale with the global W (LmLS, LcLS, GLS*) need W_A > 0.
+/// Quadratic triangles (∫N_vertex = 0) and 8-node quads (∫N_vertex < 0) fail
+/// this unless their basis is transformed first.
+///
+/// @param[in] kind The basis kind
+/// @param[in] element_weights W^e, shape (cells, functions)
+/// @param[in] nodal_weights Global W_A gathered at each cell's functions,
+/// shape (cells, functions)
+/// @param[in] num_functions Local functions per cell
+/// @param[in] relative_tolerance A weight ≤ tolerance·|e| counts as zero
+/// @throws std::domain_error naming the first offending cell and function
+void check_lumped_weights(BasisKind kind,
+                          std::span<const double> element_weights,
+                          std::span<const double> nodal_weights,
+                          std::size_t num_functions,
+                          double relative_tolerance = 1e-12);
+
+/// Per-element coefficients of a local mortar basis in the slave basis,
+/// M_A|_e = Σ_B C^e_BA N_B:
+///   LmLS*: C^e = I;  LmLS: C^e = diag(1/W);
+///   LcLS*: C^e = (L^e)⁻¹ diag(W^e);  LcLS: C^e = (L^e)⁻¹ diag(W^e) diag(1/W).
+///
+/// @param[in] kind A local kind (not GLS/GLS*, which have global support)
+/// @param[in] element_mass L^e, shape (cells, functions, functions)
+/// @param[in] element_weights W^e, shape (cells, functions)
+/// @param[in] nodal_weights Global W_A gathered at each cell's functions,
+/// shape (cells, functions)
+/// @param[in] num_functions Local functions per cell
+/// @return C^e, row-major, shape (cells, functions, functions)
+/// @throws std::invalid_argument for a global kind or inconsistent sizes
+/// @throws std::domain_error for non-positive weights or a singular L^e
+/// (degenerate element)
+std::vector<double> basis_coefficients(BasisKind kind,
+                                       std::span<const double> element_mass,
+                                       std::span<const double> element_weights,
+                                       std::span<const double> nodal_weights,
+                                       std::size_t num_functions);
+
+} // namespace dolfinx_mortar

@@ -1,0 +1,137 @@
+// Copyright (C) 2026 dolfinx_mortar developers
+// SPDX-License-Identifier: MIT
+#include <dolfinx_mortar/basis_coefficients.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+namespace dolfinx_mortar
+{
+namespace
+{
+using RowMatrix
+    = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+double element_measure(std::span<const double> w)
+{
+  return std::accumulate(w.begin(), w.end(), 0.0);
+}
+
+[[noreturn]] void throw_weight_error(BasisKind kind, std::size_t cell,
+                                     std::size_t function, double value,
+                                     double measure, bool nodal)
+{
+  std::ostringstream msg;
+  msg << "basis kind '" << to_string(kind) << "' needs "
+      << (nodal ? "W_A = ∫N_A dA > 0 at every slave function"
+                : "∫_e N_A dA > 0 on every element")
+      << ", but cell " << cell << " (local function " << function << ") has "
+      << (nodal ? "W_A = " : "∫_e N_A dA = ") << value
+      << " (element measure " << measure << ")";
+  throw std::domain_error(msg.str());
+}
+} // namespace
+
+void check_lumped_weights(BasisKind kind,
+                          std::span<const double> element_weights,
+                          std::span<const double> nodal_weights,
+                          std::size_t num_functions, double relative_tolerance)
+{
+  if (num_functions == 0 or element_weights.size() % num_functions != 0
+      or nodal_weights.size() != element_weights.size())
+    throw std::invalid_argument(
+        "element and nodal weights must both have shape (cells, functions)");
+  const bool element_check
+      = kind == BasisKind::LcLS_star or kind == BasisKind::LcLS;
+  const bool nodal_check = kind == BasisKind::LmLS or kind == BasisKind::LcLS
+                           or kind == BasisKind::GLS_star;
+  const std::size_t nc = element_weights.size() / num_functions;
+  for (std::size_t c = 0; c < nc; ++c)
+  {
+    auto we = element_weights.subspan(c * num_functions, num_functions);
+    auto wn = nodal_weights.subspan(c * num_functions, num_functions);
+    const double measure = element_measure(we);
+    if (!(measure > 0.0) or !std::isfinite(measure))
+    {
+      std::ostringstream msg;
+      msg << "degenerate slave element: cell " << c << " has measure "
+          << measure;
+      throw std::domain_error(msg.str());
+    }
+    for (std::size_t i = 0; i < num_functions; ++i)
+    {
+      if (element_check and !(we[i] > relative_tolerance * measure))
+        throw_weight_error(kind, c, i, we[i], measure, false);
+      if (nodal_check and !(wn[i] > relative_tolerance * measure))
+        throw_weight_error(kind, c, i, wn[i], measure, true);
+    }
+  }
+}
+
+std::vector<double> basis_coefficients(BasisKind kind,
+                                       std::span<const double> element_mass,
+                                       std::span<const double> element_weights,
+                                       std::span<const double> nodal_weights,
+                                       std::size_t num_functions)
+{
+  if (is_global(kind))
+    throw std::invalid_argument("basis kind '" + to_string(kind)
+                                + "' has global support: it has no "
+                                  "element-wise coefficients");
+  const std::size_t nd = num_functions;
+  if (nd == 0 or element_weights.size() % nd != 0)
+    throw std::invalid_argument("element weights must have shape (cells, "
+                                "functions)");
+  const std::size_t nc = element_weights.size() / nd;
+  if (element_mass.size() != nc * nd * nd)
+    throw std::invalid_argument("element mass matrices must have shape "
+                                "(cells, functions, functions)");
+  check_lumped_weights(kind, element_weights, nodal_weights, nd);
+
+  std::vector<double> out(nc * nd * nd, 0.0);
+  for (std::size_t c = 0; c < nc; ++c)
+  {
+    Eigen::Map<RowMatrix> C(out.data() + c * nd * nd, nd, nd);
+    Eigen::Map<const Eigen::VectorXd> We(element_weights.data() + c * nd, nd);
+    Eigen::Map<const Eigen::VectorXd> Wn(nodal_weights.data() + c * nd, nd);
+    switch (kind)
+    {
+    case BasisKind::LmLS_star:
+      C.setIdentity();
+      break;
+    case BasisKind::LmLS:
+      C = Wn.cwiseInverse().asDiagonal();
+      break;
+    case BasisKind::LcLS_star:
+    case BasisKind::LcLS:
+    {
+      Eigen::Map<const RowMatrix> Le(element_mass.data() + c * nd * nd, nd,
+                                     nd);
+      // L^e is SPD for a non-degenerate element: Cholesky both solves and
+      // detects degeneracy.
+      Eigen::LLT<Eigen::MatrixXd> llt(Le);
+      if (llt.info() != Eigen::Success)
+      {
+        std::ostringstream msg;
+        msg << "element mass matrix of cell " << c
+            << " is not positive definite: degenerate slave element";
+        throw std::domain_error(msg.str());
+      }
+      Eigen::MatrixXd rhs = We.asDiagonal();
+      if (kind == BasisKind::LcLS)
+        rhs = rhs * Wn.cwiseInverse().asDiagonal();
+      C = llt.solve(rhs);
+      break;
+    }
+    default:
+      throw std::logic_error("unreachable basis kind");
+    }
+  }
+  return out;
+}
+
+} // namespace dolfinx_mortar
