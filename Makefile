@@ -1,0 +1,71 @@
+# dolfinx_mortar: setup, demo, test, bench. Run `make help` for the targets.
+# Everything runs with Debian's interpreter: the first python3 on PATH may be
+# another one that cannot import DOLFINx.
+PYTHON ?= /usr/bin/python3
+BUILD_DIR ?= build
+MPIRUN ?= mpirun -n 2 --oversubscribe
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+# Keep OpenMP/BLAS threads from fighting the MPI ranks on a 2-core machine.
+export OMP_NUM_THREADS := 1
+
+DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
+	python3-ffcx python3-petsc4py python3-mpi4py python3-gmsh pybind11-dev \
+	libeigen3-dev python3-pytest python3-matplotlib python3-scipy python3-tqdm \
+	python3-dev cmake g++ make libgtest-dev openmpi-bin
+
+.PHONY: help setup deps build install demo test test-cpp test-python test-mpi bench clean
+
+help:
+	@echo "make setup  - install missing Debian packages, build the kernels, make dolfinx_mortar importable"
+	@echo "make demo   - setup, then the main demo (figures 1 and 2) into results/"
+	@echo "make test   - setup, then C++ tests (ctest), pytest, and pytest under mpirun -n 2"
+	@echo "make bench  - setup, then the benchmarks in benchmarks/"
+
+setup: deps build install
+
+deps:
+	@missing=""; for p in $(DEB_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  if [ "$$(id -u)" -ne 0 ]; then \
+	    echo "Missing Debian packages. Run as root:"; \
+	    echo "  apt-get update && apt-get install -y$$missing"; exit 1; \
+	  fi; \
+	  echo "Installing:$$missing"; \
+	  apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q$$missing; \
+	fi
+
+build:
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(PYTHON) > /dev/null
+	cmake --build $(BUILD_DIR) -j2
+
+# An editable install without pip: a .pth file that puts this checkout on
+# Debian's interpreter's path (what `pip install -e` would do, minus the
+# network and build isolation).
+install:
+	@site=$$($(PYTHON) -c "import site; print(site.getsitepackages()[0])"); \
+	mkdir -p $$site && echo "$(CURDIR)" > $$site/dolfinx_mortar.pth; \
+	cd / && $(PYTHON) -c "import dolfinx_mortar, sys; print('dolfinx_mortar importable from', dolfinx_mortar.__file__)"
+
+demo: setup
+	$(PYTHON) demos/fig1_bases.py --json results/fig1_bases.json
+	$(PYTHON) demos/fig2_sphere_nurbs.py --json results/fig2_pressures.json
+
+test: setup test-cpp test-python test-mpi
+
+test-cpp:
+	cd $(BUILD_DIR) && ctest --output-on-failure
+
+test-python:
+	$(PYTHON) -m pytest -q tests
+
+test-mpi:
+	$(MPIRUN) $(PYTHON) -m pytest -q -p no:cacheprovider tests
+
+bench: setup
+	$(PYTHON) benchmarks/bench_basis_construction.py
+
+clean:
+	rm -rf $(BUILD_DIR) dolfinx_mortar/_kernels*.so

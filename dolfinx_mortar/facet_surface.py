@@ -1,0 +1,96 @@
+"""Slave surfaces made of tagged facets of a DOLFINx mesh (DOLFINx 0.5.2 API).
+
+One of the few modules that call DOLFINx (DESIGN.md §6). The surface's
+functions are the (block) dofs of a Lagrange function space, numbered and
+distributed as DOLFINx numbers them, so nodal contact quantities line up with
+the displacement's dofs without any renumbering.
+"""
+from __future__ import annotations
+
+from typing import Union
+
+import dolfinx
+import numpy as np
+from dolfinx import fem
+
+from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.layout import NodeLayout
+
+_FACET_CELL = {"interval": "point", "triangle": "interval",
+               "quadrilateral": "interval", "tetrahedron": "triangle",
+               "hexahedron": "quadrilateral"}
+
+
+def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
+                  facet_tags: dolfinx.mesh.MeshTagsMetaClass, tag: int,
+                  quadratic_transform: bool = False) -> LagrangeSurface:
+    """The slave surface of the facets marked ``tag``, owned by this rank.
+
+    Parameters
+    ----------
+    space
+        A Lagrange function space (scalar or vector: its nodes are the block
+        dofs), or a mesh, in which case the space of the mesh's geometry degree
+        is used.
+    facet_tags
+        Facet meshtags.
+    tag
+        The value marking the slave facets.
+    quadratic_transform
+        Use the transformed quadratic basis on quadratic triangle facets.
+
+    Raises
+    ------
+    ValueError
+        If the tags are not facet tags, mark no facet on any rank, or the space
+        is not Lagrange of degree 1 or 2.
+    """
+    if isinstance(space, dolfinx.mesh.Mesh):
+        mesh = space
+        degree = mesh.geometry.cmap.degree
+        space = fem.FunctionSpace(mesh, ("Lagrange", degree))
+    mesh = space.mesh
+    element = space.ufl_element()
+    degree = element.degree()
+    family = element.family()
+    if family not in ("Lagrange", "Q", "P") or degree not in (1, 2):
+        raise ValueError(f"slave surfaces need a Lagrange space of degree 1 or 2, "
+                         f"got {family} of degree {degree}")
+    tdim = mesh.topology.dim
+    fdim = tdim - 1
+    if tdim < 2:
+        raise ValueError("slave surfaces need a 2D or 3D mesh")
+    if facet_tags.dim != fdim:
+        raise ValueError(f"the meshtags have dimension {facet_tags.dim}, but the slave "
+                         f"surface needs facet tags (dimension {fdim}) of this "
+                         f"{tdim}D mesh")
+    comm = mesh.comm
+    facets = facet_tags.find(tag)
+    facets = facets[facets < mesh.topology.index_map(fdim).size_local]
+    if comm.allreduce(len(facets)) == 0:
+        present = np.unique(comm.allgather(np.unique(facet_tags.values)))
+        raise ValueError(f"facet tag {tag} marks no facets of the mesh (tags present: "
+                         f"{sorted(set(np.concatenate(present).tolist())) if len(present) else []})")
+
+    mesh.topology.create_connectivity(fdim, tdim)
+    mesh.topology.create_connectivity(tdim, fdim)
+    f2c = mesh.topology.connectivity(fdim, tdim)
+    c2f = mesh.topology.connectivity(tdim, fdim)
+    cell_of_facet = f2c.array[f2c.offsets[facets]]
+    num_facets_per_cell = c2f.offsets[1] - c2f.offsets[0]
+    cell_facets = c2f.array.reshape(-1, num_facets_per_cell)[cell_of_facet]
+    local_facet = np.argmax(cell_facets == facets[:, None], axis=1)
+
+    dof_layout = space.dofmap.dof_layout
+    closure = np.array([dof_layout.entity_closure_dofs(fdim, i)
+                        for i in range(num_facets_per_cell)], dtype=np.int64)
+    cell_dofs = space.dofmap.list.array.reshape(-1, dof_layout.num_dofs)
+    cells = cell_dofs[cell_of_facet[:, None], closure[local_facet]]
+
+    index_map = space.dofmap.index_map
+    layout = NodeLayout(comm, index_map.size_local, index_map.ghosts)
+    gdim = mesh.geometry.dim
+    x = space.tabulate_dof_coordinates()[:, :gdim]
+    facet_cell = _FACET_CELL[mesh.topology.cell_type.name]
+    return LagrangeSurface(facet_cell, degree, x, cells, layout=layout,
+                           quadratic_transform=quadratic_transform)
