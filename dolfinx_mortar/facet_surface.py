@@ -68,9 +68,10 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     facets = facet_tags.find(tag)
     facets = facets[facets < mesh.topology.index_map(fdim).size_local]
     if comm.allreduce(len(facets)) == 0:
-        present = np.unique(comm.allgather(np.unique(facet_tags.values)))
+        present = sorted({int(v) for values in comm.allgather(np.unique(facet_tags.values))
+                          for v in values})
         raise ValueError(f"facet tag {tag} marks no facets of the mesh (tags present: "
-                         f"{sorted(set(np.concatenate(present).tolist())) if len(present) else []})")
+                         f"{present})")
 
     mesh.topology.create_connectivity(fdim, tdim)
     mesh.topology.create_connectivity(tdim, fdim)

@@ -134,9 +134,10 @@ class NodeLayout:
         lgmap = PETSc.LGMap().create(self.global_indices.astype(PETSc.IntType),
                                      comm=self.comm)
         mat.setLGMap(lgmap, lgmap)
-        mat.setValuesLocalRCV(cells, cells,
-                              np.ascontiguousarray(element_matrices).reshape(nc, nd * nd),
-                              addv=PETSc.InsertMode.ADD_VALUES)
+        if nc > 0:  # petsc4py divides by the batch size
+            mat.setValuesLocalRCV(cells, cells,
+                                  np.ascontiguousarray(element_matrices).reshape(nc, nd * nd),
+                                  addv=PETSc.InsertMode.ADD_VALUES)
         untouched = np.flatnonzero(touches[: self.num_owned] == 0).astype(PETSc.IntType)
         for i in untouched:
             mat.setValueLocal(i, i, 1.0, addv=PETSc.InsertMode.ADD_VALUES)

@@ -1,0 +1,110 @@
+"""Bad input gets a clear error that names the problem."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from dolfinx_mortar import MortarBasis, basis, nurbs
+from dolfinx_mortar.facet_surface import facet_surface
+from dolfinx_mortar.lagrange import LagrangeSurface
+
+from surfaces import curved_patch
+
+W_KINDS = ["GLS*", "LmLS", "LcLS*", "LcLS"]
+
+
+def test_unknown_kind_is_named():
+    curve = nurbs.BSplineCurve(degree=2, n_elements=3)
+    with pytest.raises(ValueError, match="unknown mortar basis kind 'LcLS\\*\\*'.*GLS"):
+        basis.evaluate("LcLS**", curve, [0.5])
+    with pytest.raises(TypeError, match="string"):
+        MortarBasis(3, curve)
+
+
+def test_aliases_are_the_same_bases():
+    curve = nurbs.BSplineCurve(degree=2, n_elements=4)
+    x = np.linspace(0, 1, 9)
+    for alias, kind in [("standard", "LmLS*"), ("weighted", "LmLS"), ("dual", "LcLS*")]:
+        assert np.array_equal(basis.evaluate(alias, curve, x), basis.evaluate(kind, curve, x))
+
+
+@pytest.mark.parametrize("kind", W_KINDS)
+@pytest.mark.parametrize("cell, serendipity", [("triangle", False), ("quadrilateral", True)])
+def test_singular_lumped_weights_of_quadratic_facets_are_reported(kind, cell, serendipity):
+    surface = curved_patch(cell, 2, n=2, serendipity=serendipity)
+    with pytest.raises(ValueError, match="transformed quadratic basis") as err:
+        MortarBasis(kind, surface)
+    assert surface.description in str(err.value)
+
+
+@pytest.mark.parametrize("kind", ["GLS", "LmLS*"])
+def test_kinds_without_lumped_weights_work_on_plain_quadratic_triangles(kind):
+    b = MortarBasis(kind, curved_patch("triangle", 2, n=2))
+    assert np.all(np.isfinite(b.nodal_values(lambda x: 1.0 + x[0])))
+
+
+def test_degenerate_facet_is_reported():
+    x = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    surface = LagrangeSurface("interval", 1, x, [[0, 1], [1, 2], [2, 3]])
+    with pytest.raises(ValueError, match="degenerate slave element: cell 1"):
+        MortarBasis("LcLS*", surface)
+
+
+def test_nan_field_is_reported():
+    curve = nurbs.BSplineCurve(degree=2, n_elements=3)
+    with pytest.raises(ValueError, match="NaN"):
+        basis.nodal_pressures("GLS", curve, lambda x: np.full(x.shape[1], np.nan))
+
+
+def test_field_of_wrong_shape_is_reported():
+    curve = nurbs.BSplineCurve(degree=2, n_elements=3)
+    with pytest.raises(ValueError, match="shape"):
+        basis.nodal_pressures("LcLS", curve, lambda x: x)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(degree=0, n_elements=3), "degree"),
+    (dict(degree=2, n_elements=0), "element"),
+    (dict(degree=2, n_elements=3, weights=[1, 1, -1, 1, 1]), "positive"),
+    (dict(degree=2, n_elements=3, weights=[1, 1, 1]), "shape"),
+    (dict(degree=2, knots=[0, 0.5, 1, 1, 1, 1]), "open"),
+])
+def test_bad_nurbs_input_is_reported(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        nurbs.BSplineCurve(**kwargs)
+
+
+def test_parameters_outside_the_curve_are_reported():
+    with pytest.raises(ValueError, match=r"\[0.0, 1.0\]"):
+        basis.evaluate("GLS", nurbs.BSplineCurve(degree=2, n_elements=3), [1.5])
+
+
+def _unit_square_with_tags(values):
+    domain = mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    facets = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 0.0))
+    tags = mesh.meshtags(domain, 1, np.sort(facets).astype(np.int32),
+                         np.full(len(facets), values, dtype=np.int32))
+    return domain, tags
+
+
+def test_empty_tag_is_reported_with_the_tags_present():
+    domain, tags = _unit_square_with_tags(3)
+    with pytest.raises(ValueError, match=r"facet tag 5 marks no facets.*\[3\]"):
+        facet_surface(domain, tags, 5)
+
+
+def test_cell_tags_instead_of_facet_tags_are_reported():
+    domain, _ = _unit_square_with_tags(3)
+    cells = np.arange(domain.topology.index_map(2).size_local, dtype=np.int32)
+    cell_tags = mesh.meshtags(domain, 2, cells, np.ones_like(cells))
+    with pytest.raises(ValueError, match="dimension 2.*facet tags \\(dimension 1\\)"):
+        facet_surface(domain, cell_tags, 1)
+
+
+def test_unsupported_space_is_reported():
+    domain, tags = _unit_square_with_tags(3)
+    V = fem.FunctionSpace(domain, ("Lagrange", 3))
+    with pytest.raises(ValueError, match="degree 1 or 2"):
+        facet_surface(V, tags, 3)
