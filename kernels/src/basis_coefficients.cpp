@@ -13,42 +13,49 @@ namespace dolfinx_mortar
 {
 namespace
 {
-using RowMatrix
-    = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using RowMatrix =
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-double element_measure(std::span<const double> w)
+double
+element_measure(std::span<const double> w)
 {
   return std::accumulate(w.begin(), w.end(), 0.0);
 }
 
-[[noreturn]] void throw_weight_error(BasisKind kind, std::size_t cell,
-                                     std::size_t function, double value,
-                                     double measure, bool nodal)
+[[noreturn]] void
+throw_weight_error(BasisKind kind,
+                   std::size_t cell,
+                   std::size_t function,
+                   double value,
+                   double measure,
+                   bool nodal)
 {
   std::ostringstream msg;
   msg << "basis kind '" << to_string(kind) << "' needs "
       << (nodal ? "W_A = ∫N_A dA > 0 at every slave function"
                 : "∫_e N_A dA > 0 on every element")
       << ", but cell " << cell << " (local function " << function << ") has "
-      << (nodal ? "W_A = " : "∫_e N_A dA = ") << value
-      << " (element measure " << measure << ")";
+      << (nodal ? "W_A = " : "∫_e N_A dA = ") << value << " (element measure "
+      << measure << ")";
   throw std::domain_error(msg.str());
 }
 } // namespace
 
-void check_lumped_weights(BasisKind kind,
-                          std::span<const double> element_weights,
-                          std::span<const double> nodal_weights,
-                          std::size_t num_functions, double relative_tolerance)
+void
+check_lumped_weights(BasisKind kind,
+                     std::span<const double> element_weights,
+                     std::span<const double> nodal_weights,
+                     std::size_t num_functions,
+                     double relative_tolerance)
 {
-  if (num_functions == 0 or element_weights.size() % num_functions != 0
-      or nodal_weights.size() != element_weights.size())
+  if (num_functions == 0 or element_weights.size() % num_functions != 0 or
+      nodal_weights.size() != element_weights.size())
     throw std::invalid_argument(
-        "element and nodal weights must both have shape (cells, functions)");
-  const bool element_check
-      = kind == BasisKind::LcLS_star or kind == BasisKind::LcLS;
-  const bool nodal_check = kind == BasisKind::LmLS or kind == BasisKind::LcLS
-                           or kind == BasisKind::GLS_star;
+      "element and nodal weights must both have shape (cells, functions)");
+  const bool element_check =
+    kind == BasisKind::LcLS_star or kind == BasisKind::LcLS;
+  const bool nodal_check = kind == BasisKind::LmLS or kind == BasisKind::LcLS or
+                           kind == BasisKind::GLS_star;
   const std::size_t nc = element_weights.size() / num_functions;
   for (std::size_t c = 0; c < nc; ++c)
   {
@@ -72,16 +79,17 @@ void check_lumped_weights(BasisKind kind,
   }
 }
 
-std::vector<double> basis_coefficients(BasisKind kind,
-                                       std::span<const double> element_mass,
-                                       std::span<const double> element_weights,
-                                       std::span<const double> nodal_weights,
-                                       std::size_t num_functions)
+std::vector<double>
+basis_coefficients(BasisKind kind,
+                   std::span<const double> element_mass,
+                   std::span<const double> element_weights,
+                   std::span<const double> nodal_weights,
+                   std::size_t num_functions)
 {
   if (is_global(kind))
-    throw std::invalid_argument("basis kind '" + to_string(kind)
-                                + "' has global support: it has no "
-                                  "element-wise coefficients");
+    throw std::invalid_argument("basis kind '" + to_string(kind) +
+                                "' has global support: it has no "
+                                "element-wise coefficients");
   const std::size_t nd = num_functions;
   if (nd == 0 or element_weights.size() % nd != 0)
     throw std::invalid_argument("element weights must have shape (cells, "
@@ -100,35 +108,35 @@ std::vector<double> basis_coefficients(BasisKind kind,
     Eigen::Map<const Eigen::VectorXd> Wn(nodal_weights.data() + c * nd, nd);
     switch (kind)
     {
-    case BasisKind::LmLS_star:
-      C.setIdentity();
-      break;
-    case BasisKind::LmLS:
-      C = Wn.cwiseInverse().asDiagonal();
-      break;
-    case BasisKind::LcLS_star:
-    case BasisKind::LcLS:
-    {
-      Eigen::Map<const RowMatrix> Le(element_mass.data() + c * nd * nd, nd,
-                                     nd);
-      // L^e is SPD for a non-degenerate element: Cholesky both solves and
-      // detects degeneracy.
-      Eigen::LLT<Eigen::MatrixXd> llt(Le);
-      if (llt.info() != Eigen::Success)
+      case BasisKind::LmLS_star:
+        C.setIdentity();
+        break;
+      case BasisKind::LmLS:
+        C = Wn.cwiseInverse().asDiagonal();
+        break;
+      case BasisKind::LcLS_star:
+      case BasisKind::LcLS:
       {
-        std::ostringstream msg;
-        msg << "element mass matrix of cell " << c
-            << " is not positive definite: degenerate slave element";
-        throw std::domain_error(msg.str());
+        Eigen::Map<const RowMatrix> Le(
+          element_mass.data() + c * nd * nd, nd, nd);
+        // L^e is SPD for a non-degenerate element: Cholesky both solves and
+        // detects degeneracy.
+        Eigen::LLT<Eigen::MatrixXd> llt(Le);
+        if (llt.info() != Eigen::Success)
+        {
+          std::ostringstream msg;
+          msg << "element mass matrix of cell " << c
+              << " is not positive definite: degenerate slave element";
+          throw std::domain_error(msg.str());
+        }
+        Eigen::MatrixXd rhs = We.asDiagonal();
+        if (kind == BasisKind::LcLS)
+          rhs = rhs * Wn.cwiseInverse().asDiagonal();
+        C = llt.solve(rhs);
+        break;
       }
-      Eigen::MatrixXd rhs = We.asDiagonal();
-      if (kind == BasisKind::LcLS)
-        rhs = rhs * Wn.cwiseInverse().asDiagonal();
-      C = llt.solve(rhs);
-      break;
-    }
-    default:
-      throw std::logic_error("unreachable basis kind");
+      default:
+        throw std::logic_error("unreachable basis kind");
     }
   }
   return out;

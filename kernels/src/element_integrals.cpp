@@ -10,27 +10,30 @@ namespace dolfinx_mortar
 {
 namespace
 {
-using RowMatrix
-    = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using RowMatrix =
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-void check_sizes(std::span<const double> phi, std::span<const double> weights,
-                 TabulationShape shape)
+void
+check_sizes(std::span<const double> phi,
+            std::span<const double> weights,
+            TabulationShape shape)
 {
   const auto [nc, nq, nd] = shape;
   if (phi.size() != nc * nq * nd)
-    throw std::invalid_argument("phi has " + std::to_string(phi.size())
-                                + " values, expected cells*points*functions = "
-                                + std::to_string(nc * nq * nd));
+    throw std::invalid_argument("phi has " + std::to_string(phi.size()) +
+                                " values, expected cells*points*functions = " +
+                                std::to_string(nc * nq * nd));
   if (weights.size() != nc * nq)
-    throw std::invalid_argument("weights have " + std::to_string(weights.size())
-                                + " values, expected cells*points = "
-                                + std::to_string(nc * nq));
+    throw std::invalid_argument(
+      "weights have " + std::to_string(weights.size()) +
+      " values, expected cells*points = " + std::to_string(nc * nq));
 }
 } // namespace
 
-std::vector<double> element_integrals(std::span<const double> phi,
-                                      std::span<const double> weights,
-                                      TabulationShape shape)
+std::vector<double>
+element_integrals(std::span<const double> phi,
+                  std::span<const double> weights,
+                  TabulationShape shape)
 {
   check_sizes(phi, weights, shape);
   const auto [nc, nq, nd] = shape;
@@ -44,9 +47,10 @@ std::vector<double> element_integrals(std::span<const double> phi,
   return out;
 }
 
-std::vector<double> element_mass_matrices(std::span<const double> phi,
-                                          std::span<const double> weights,
-                                          TabulationShape shape)
+std::vector<double>
+element_mass_matrices(std::span<const double> phi,
+                      std::span<const double> weights,
+                      TabulationShape shape)
 {
   check_sizes(phi, weights, shape);
   const auto [nc, nq, nd] = shape;
@@ -55,8 +59,8 @@ std::vector<double> element_mass_matrices(std::span<const double> phi,
   {
     Eigen::Map<const RowMatrix> N(phi.data() + c * nq * nd, nq, nd);
     Eigen::Map<const Eigen::VectorXd> w(weights.data() + c * nq, nq);
-    Eigen::Map<RowMatrix>(out.data() + c * nd * nd, nd, nd)
-        = N.transpose() * w.asDiagonal() * N;
+    Eigen::Map<RowMatrix>(out.data() + c * nd * nd, nd, nd) =
+      N.transpose() * w.asDiagonal() * N;
   }
   return out;
 }

@@ -21,11 +21,12 @@ struct LineTabulation
   TabulationShape shape;
 };
 
-LineTabulation p1_lines(const std::vector<double>& lengths)
+LineTabulation
+p1_lines(const std::vector<double>& lengths)
 {
   const double g = 0.5 / std::sqrt(3.0);
-  const std::array<double, 2> xi = {0.5 - g, 0.5 + g};
-  LineTabulation t{{}, {}, {lengths.size(), 2, 2}};
+  const std::array<double, 2> xi = { 0.5 - g, 0.5 + g };
+  LineTabulation t{ {}, {}, { lengths.size(), 2, 2 } };
   for (double h : lengths)
     for (double x : xi)
     {
@@ -39,7 +40,7 @@ LineTabulation p1_lines(const std::vector<double>& lengths)
 
 TEST(ElementIntegrals, P1LineMassMatrixIsExact)
 {
-  auto t = p1_lines({2.0});
+  auto t = p1_lines({ 2.0 });
   auto L = element_mass_matrices(t.phi, t.weights, t.shape);
   EXPECT_NEAR(L[0], 2.0 / 3.0, 1e-15);
   EXPECT_NEAR(L[1], 1.0 / 3.0, 1e-15);
@@ -51,7 +52,7 @@ TEST(ElementIntegrals, P1LineMassMatrixIsExact)
 
 TEST(BasisCoefficients, DualP1LineIsBiorthogonalAndPU)
 {
-  auto t = p1_lines({0.7});
+  auto t = p1_lines({ 0.7 });
   auto L = element_mass_matrices(t.phi, t.weights, t.shape);
   auto W = element_integrals(t.phi, t.weights, t.shape);
   auto C = basis_coefficients(BasisKind::LcLS_star, L, W, W, 2);
@@ -71,8 +72,8 @@ TEST(BasisCoefficients, DualP1LineIsBiorthogonalAndPU)
 
 TEST(BasisCoefficients, ZeroWeightIsRejectedByWeightedKinds)
 {
-  std::vector<double> L = {1.0, 0.0, 0.0, 1.0};
-  std::vector<double> W = {1.0, 0.0};
+  std::vector<double> L = { 1.0, 0.0, 0.0, 1.0 };
+  std::vector<double> W = { 1.0, 0.0 };
   EXPECT_THROW(basis_coefficients(BasisKind::LcLS_star, L, W, W, 2),
                std::domain_error);
   EXPECT_THROW(basis_coefficients(BasisKind::LmLS, L, W, W, 2),
@@ -82,7 +83,7 @@ TEST(BasisCoefficients, ZeroWeightIsRejectedByWeightedKinds)
 
 TEST(BasisCoefficients, DegenerateElementIsRejected)
 {
-  auto t = p1_lines({0.0});
+  auto t = p1_lines({ 0.0 });
   auto L = element_mass_matrices(t.phi, t.weights, t.shape);
   auto W = element_integrals(t.phi, t.weights, t.shape);
   EXPECT_THROW(basis_coefficients(BasisKind::LcLS_star, L, W, W, 2),
@@ -91,7 +92,7 @@ TEST(BasisCoefficients, DegenerateElementIsRejected)
 
 TEST(BasisCoefficients, GlobalKindsHaveNoElementCoefficients)
 {
-  std::vector<double> L = {1.0}, W = {1.0};
+  std::vector<double> L = { 1.0 }, W = { 1.0 };
   EXPECT_THROW(basis_coefficients(BasisKind::GLS, L, W, W, 1),
                std::invalid_argument);
 }

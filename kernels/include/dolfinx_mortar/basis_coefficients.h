@@ -25,11 +25,12 @@ namespace dolfinx_mortar
 /// @param[in] num_functions Local functions per cell
 /// @param[in] relative_tolerance A weight ≤ tolerance·|e| counts as zero
 /// @throws std::domain_error naming the first offending cell and function
-void check_lumped_weights(BasisKind kind,
-                          std::span<const double> element_weights,
-                          std::span<const double> nodal_weights,
-                          std::size_t num_functions,
-                          double relative_tolerance = 1e-12);
+void
+check_lumped_weights(BasisKind kind,
+                     std::span<const double> element_weights,
+                     std::span<const double> nodal_weights,
+                     std::size_t num_functions,
+                     double relative_tolerance = 1e-12);
 
 /// Per-element coefficients of a local mortar basis in the slave basis,
 /// M_A|_e = Σ_B C^e_BA N_B:
@@ -46,10 +47,11 @@ void check_lumped_weights(BasisKind kind,
 /// @throws std::invalid_argument for a global kind or inconsistent sizes
 /// @throws std::domain_error for non-positive weights or a singular L^e
 /// (degenerate element)
-std::vector<double> basis_coefficients(BasisKind kind,
-                                       std::span<const double> element_mass,
-                                       std::span<const double> element_weights,
-                                       std::span<const double> nodal_weights,
-                                       std::size_t num_functions);
+std::vector<double>
+basis_coefficients(BasisKind kind,
+                   std::span<const double> element_mass,
+                   std::span<const double> element_weights,
+                   std::span<const double> nodal_weights,
+                   std::size_t num_functions);
 
 } // namespace dolfinx_mortar

@@ -20,9 +20,10 @@ using TabulationShape = std::array<std::size_t, 3>;
 /// @param[in] weights Quadrature weight × |J| × f(x_q), shape (cells, points)
 /// @param[in] shape The shape of @p phi
 /// @return Row-major array of shape (cells, functions)
-std::vector<double> element_integrals(std::span<const double> phi,
-                                      std::span<const double> weights,
-                                      TabulationShape shape);
+std::vector<double>
+element_integrals(std::span<const double> phi,
+                  std::span<const double> weights,
+                  TabulationShape shape);
 
 /// Element mass matrices L^e_ij = ∫_e N_i N_j dA.
 ///
@@ -30,8 +31,9 @@ std::vector<double> element_integrals(std::span<const double> phi,
 /// @param[in] weights Quadrature weight × |J|, shape (cells, points)
 /// @param[in] shape The shape of @p phi
 /// @return Row-major array of shape (cells, functions, functions)
-std::vector<double> element_mass_matrices(std::span<const double> phi,
-                                          std::span<const double> weights,
-                                          TabulationShape shape);
+std::vector<double>
+element_mass_matrices(std::span<const double> phi,
+                      std::span<const double> weights,
+                      TabulationShape shape);
 
 } // namespace dolfinx_mortar

@@ -1,0 +1,53 @@
+"""Result files that are either complete or absent.
+
+Every result is written to a temporary file in the target folder and renamed
+into place, so an interrupted run never leaves a truncated JSON, CSV or PNG.
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any, Callable, Union
+
+PathLike = Union[str, os.PathLike]
+
+
+def write_atomically(path: PathLike, write: Callable[[str], None]) -> Path:
+    """Call ``write(tmp_path)`` and move the result to ``path``.
+
+    Parameters
+    ----------
+    path
+        Final location; its folder is created if needed.
+    write
+        Writes the complete file at the temporary path it is given.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+    return path
+
+
+def write_json(path: PathLike, data: Any) -> Path:
+    """Write ``data`` as indented JSON, atomically."""
+    def write(tmp: str) -> None:
+        with open(tmp, "w") as f:
+            json.dump(data, f, indent=2, sort_keys=True)
+            f.write("\n")
+    return write_atomically(path, write)
+
+
+def save_figure(path: PathLike, figure: Any, **kwargs: Any) -> Path:
+    """Save a matplotlib figure atomically (format from the suffix)."""
+    fmt = Path(path).suffix.lstrip(".") or "png"
+    return write_atomically(path, lambda tmp: figure.savefig(tmp, format=fmt, **kwargs))
