@@ -139,8 +139,10 @@ class NodeLayout:
                                   np.ascontiguousarray(element_matrices).reshape(nc, nd * nd),
                                   addv=PETSc.InsertMode.ADD_VALUES)
         untouched = np.flatnonzero(touches[: self.num_owned] == 0).astype(PETSc.IntType)
-        for i in untouched:
-            mat.setValueLocal(i, i, 1.0, addv=PETSc.InsertMode.ADD_VALUES)
+        if len(untouched) > 0:
+            mat.setValuesLocalRCV(untouched[:, None], untouched[:, None],
+                                  np.ones((len(untouched), 1)),
+                                  addv=PETSc.InsertMode.ADD_VALUES)
         mat.assemble()
         mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return mat
