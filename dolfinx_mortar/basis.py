@@ -74,8 +74,9 @@ class MortarBasis:
             _kernels.check_lumped_weights(self.kind, self.element_weights, nodal_at_cells)
             if is_global(self.kind):
                 self.coefficients = None
-                self._solver: Optional[MassMatrixSolver] = MassMatrixSolver(
-                    self.layout, self.layout.assemble_matrix(self.cells, self.element_mass))
+                mass = self.layout.assemble_matrix(self.cells, self.element_mass)
+                mass.setOption(mass.Option.SYMMETRIC, True)
+                self._solver: Optional[MassMatrixSolver] = MassMatrixSolver(self.layout, mass)
             else:
                 self._solver = None
                 self.coefficients = _kernels.basis_coefficients(

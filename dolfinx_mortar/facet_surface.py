@@ -24,7 +24,10 @@ _FACET_CELL = {"interval": "point", "triangle": "interval",
 def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
                   facet_tags: dolfinx.mesh.MeshTagsMetaClass, tag: int,
                   quadratic_transform: bool = False) -> LagrangeSurface:
-    """The slave surface of the facets marked ``tag``, owned by this rank.
+    """The surface of the facets marked ``tag``, owned by this rank.
+
+    Facet nodes are ordered so that the natural normal of every facet points
+    out of the body (required by segmentation; harmless for the bases).
 
     Parameters
     ----------
@@ -93,5 +96,14 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     gdim = mesh.geometry.dim
     x = space.tabulate_dof_coordinates()[:, :gdim]
     facet_cell = _FACET_CELL[mesh.topology.cell_type.name]
-    return LagrangeSurface(facet_cell, degree, x, cells, layout=layout,
-                           quadratic_transform=quadratic_transform)
+    surface = LagrangeSurface(facet_cell, degree, x, cells, layout=layout,
+                              quadratic_transform=quadratic_transform)
+    if len(cells) == 0:
+        return surface
+    # Outward: the facet normal must point away from its cell's centroid.
+    geometry_dofs = mesh.geometry.dofmap.array.reshape(len(cell_dofs), -1)
+    cell_centres = mesh.geometry.x[geometry_dofs[cell_of_facet], :gdim].mean(axis=1)
+    facet_centres = x[cells].mean(axis=1)
+    normals = surface.cell_normals().mean(axis=1)
+    inward = np.einsum("cg,cg->c", normals, facet_centres - cell_centres) < 0
+    return surface.reflected(inward) if np.any(inward) else surface

@@ -12,6 +12,7 @@ import basix
 import numpy as np
 import numpy.typing as npt
 
+from dolfinx_mortar import _kernels
 from dolfinx_mortar.layout import NodeLayout
 from dolfinx_mortar.tabulation import Tabulation
 
@@ -20,6 +21,25 @@ FloatArray = npt.NDArray[np.float64]
 _CELL_TYPES = {"interval": basix.CellType.interval,
                "triangle": basix.CellType.triangle,
                "quadrilateral": basix.CellType.quadrilateral}
+
+_FACET_TYPES = {("interval", 1, False): _kernels.FacetType.P1_line,
+                ("interval", 2, False): _kernels.FacetType.P2_line,
+                ("triangle", 1, False): _kernels.FacetType.P1_triangle,
+                ("triangle", 2, False): _kernels.FacetType.P2_triangle,
+                ("quadrilateral", 1, False): _kernels.FacetType.Q1_quadrilateral,
+                ("quadrilateral", 2, False): _kernels.FacetType.Q2_quadrilateral,
+                ("quadrilateral", 2, True): _kernels.FacetType.Q8_quadrilateral}
+
+# Reflections of the reference cell in Basix ordering: lines swap their ends;
+# triangles and quadrilaterals swap vertices 1 and 2, and with them the edges
+# that meet there.
+_REFLECTIONS = {("interval", 1, False): [1, 0],
+                ("interval", 2, False): [1, 0, 2],
+                ("triangle", 1, False): [0, 2, 1],
+                ("triangle", 2, False): [0, 2, 1, 3, 5, 4],
+                ("quadrilateral", 1, False): [0, 2, 1, 3],
+                ("quadrilateral", 2, False): [0, 2, 1, 3, 5, 4, 7, 6, 8],
+                ("quadrilateral", 2, True): [0, 2, 1, 3, 5, 4, 7, 6]}
 
 #: α of the transformed quadratic basis (Popp, Gitterle, Gee, Wall 2010;
 #: Wohlmuth, Popp, Gee, Wall 2012): Ñ_v = N_v + α Σ_{edges e ∋ v} N_e,
@@ -77,6 +97,9 @@ class ReferenceLagrange:
             self._to_nodal = None
             self.nodes = self._element.points
         self.num_functions = len(self.nodes)
+        self.facet_type = _FACET_TYPES[(cell, degree, serendipity)]
+        #: node permutation that reflects the reference cell (flips the normal)
+        self.reflection = np.array(_REFLECTIONS[(cell, degree, serendipity)])
         self.transform = self._quadratic_transform() if quadratic_transform else None
         names = {("interval", 1): "P1 line", ("interval", 2): "P2 line",
                  ("triangle", 1): "P1 triangle", ("triangle", 2): "P2 (6-node) triangle",
@@ -168,6 +191,29 @@ class LagrangeSurface:
         self.description = self.reference.name
         self.tdim = self.reference.tdim
         self.gdim = self.x.shape[1]
+
+    @property
+    def facet_type(self):
+        """The kernels' :class:`FacetType` of the cells."""
+        return self.reference.facet_type
+
+    def cell_normals(self, x: Optional[FloatArray] = None) -> FloatArray:
+        """Unit normal of each cell at each of its nodes, (cells, nodes, gdim).
+
+        The normal follows the node ordering: (t_y, -t_x) in 2D, ∂x/∂X₀ × ∂x/∂X₁ in 3D.
+        """
+        x = self.x if x is None else x
+        return _kernels.element_node_normals(self.facet_type, x,
+                                             self.cells.astype(np.int32))
+
+    def reflected(self, which: npt.ArrayLike) -> "LagrangeSurface":
+        """The same surface with the cells marked in ``which`` reflected (normal flipped)."""
+        cells = self.cells.copy()
+        which = np.asarray(which, dtype=bool)
+        cells[which] = cells[which][:, self.reference.reflection]
+        return LagrangeSurface(self.reference.cell, self.reference.degree, self.x, cells,
+                               layout=self.layout, serendipity=self.reference.serendipity,
+                               quadratic_transform=self.reference.transform is not None)
 
     @property
     def num_elements(self) -> int:

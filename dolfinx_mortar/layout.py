@@ -114,38 +114,63 @@ class NodeLayout:
         return out
 
     def assemble_matrix(self, cells: IntArray, element_matrices: FloatArray) -> PETSc.Mat:
-        """Assemble element matrices into a distributed AIJ matrix.
+        """Assemble square element matrices into a distributed AIJ matrix.
 
         Rows of functions that no element touches (possible when the layout is a
         DOLFINx function space and the surface a part of its boundary) get a unit
         diagonal, so the matrix stays invertible without renumbering the surface.
         """
-        cells = np.asarray(cells, dtype=PETSc.IntType)
-        nc, nd = cells.shape
-        touches = self.sum_at_functions(cells, np.ones(cells.shape))
-        # Generous preallocation bound: each touching element adds at most nd
-        # columns. Off-rank contributions make an exact count costly.
-        bound = np.minimum(touches[: self.num_owned] * nd + 1, self.size_global)
-        bound = bound.astype(PETSc.IntType)
-        mat = PETSc.Mat().createAIJ(((self.num_owned, self.size_global),
-                                     (self.num_owned, self.size_global)),
-                                    nnz=(bound, bound), comm=self.comm)
-        mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        lgmap = PETSc.LGMap().create(self.global_indices.astype(PETSc.IntType),
-                                     comm=self.comm)
-        mat.setLGMap(lgmap, lgmap)
-        if nc > 0:  # petsc4py divides by the batch size
-            mat.setValuesLocalRCV(cells, cells,
-                                  np.ascontiguousarray(element_matrices).reshape(nc, nd * nd),
-                                  addv=PETSc.InsertMode.ADD_VALUES)
-        untouched = np.flatnonzero(touches[: self.num_owned] == 0).astype(PETSc.IntType)
+        cells = np.asarray(cells, dtype=np.int64)
+        return assemble_blocks(self, cells, self, self.global_indices[cells],
+                               element_matrices, unit_diagonal=True)
+
+
+def assemble_blocks(rows: NodeLayout, row_cells: IntArray, cols: NodeLayout,
+                    col_global: IntArray, blocks: FloatArray,
+                    unit_diagonal: bool = False) -> PETSc.Mat:
+    """Assemble dense blocks into a distributed AIJ matrix (rows × cols).
+
+    Parameters
+    ----------
+    rows, cols
+        Layouts of the row and column functions.
+    row_cells
+        Local row indices of each block, shape (blocks, nr).
+    col_global
+        Global column indices of each block, shape (blocks, nc).
+    blocks
+        Values, shape (blocks, nr, nc); added where blocks overlap.
+    unit_diagonal
+        Put 1 on the diagonal of owned rows that no block touches (square
+        matrices only).
+    """
+    row_cells = np.asarray(row_cells, dtype=np.int64)
+    nb, nr = row_cells.shape
+    nc = np.asarray(col_global).shape[1] if nb else 1
+    touches = rows.sum_at_functions(row_cells, np.ones(row_cells.shape))
+    # Each touching block adds at most nc columns; off-rank contributions make
+    # an exact count costly, so preallocate this bound.
+    bound = np.minimum(touches[: rows.num_owned] * nc + 1, cols.size_global)
+    bound = bound.astype(PETSc.IntType)
+    mat = PETSc.Mat().createAIJ(((rows.num_owned, rows.size_global),
+                                 (cols.num_owned, cols.size_global)),
+                                nnz=(np.minimum(bound, max(cols.num_owned, 1)), bound),
+                                comm=rows.comm)
+    mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    row_global = rows.global_indices[row_cells].astype(PETSc.IntType)
+    if nb > 0:  # petsc4py divides by the batch size
+        mat.setValuesRCV(row_global, np.asarray(col_global, dtype=PETSc.IntType),
+                         np.ascontiguousarray(blocks, dtype=np.float64).reshape(nb, nr * nc),
+                         addv=PETSc.InsertMode.ADD_VALUES)
+    if unit_diagonal:
+        untouched = (rows.offset + np.flatnonzero(touches[: rows.num_owned] == 0)
+                     ).astype(PETSc.IntType)
         if len(untouched) > 0:
-            mat.setValuesLocalRCV(untouched[:, None], untouched[:, None],
-                                  np.ones((len(untouched), 1)),
-                                  addv=PETSc.InsertMode.ADD_VALUES)
-        mat.assemble()
-        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        return mat
+            mat.setValuesRCV(untouched[:, None], untouched[:, None],
+                             np.ones((len(untouched), 1)),
+                             addv=PETSc.InsertMode.ADD_VALUES)
+    mat.assemble()
+    return mat
 
 
 class MassMatrixSolver:

@@ -4,7 +4,11 @@
 // Thin bindings: numpy in, numpy out, no logic beyond shape handling.
 #include <dolfinx_mortar/basis_coefficients.h>
 #include <dolfinx_mortar/basis_kind.h>
+#include <dolfinx_mortar/bounding_box_tree.h>
 #include <dolfinx_mortar/element_integrals.h>
+#include <dolfinx_mortar/facet_element.h>
+#include <dolfinx_mortar/mortar_integrals.h>
+#include <dolfinx_mortar/surface_geometry.h>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -19,6 +23,33 @@ using namespace dolfinx_mortar;
 namespace
 {
 using array_t = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using int_array_t =
+  py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>;
+
+template<typename T>
+py::array_t<T>
+to_numpy_as(const std::vector<T>& v, std::vector<py::ssize_t> shape)
+{
+  return py::array_t<T>(shape, v.data());
+}
+
+/// A FacetSurface viewing numpy arrays that the caller keeps alive.
+FacetSurface
+surface_view(FacetType type, const array_t& x, const int_array_t& cells)
+{
+  if (x.ndim() != 2 or cells.ndim() != 2)
+    throw std::invalid_argument(
+      "x must be (nodes, gdim), cells (cells, nodes)");
+  if (cells.shape(1) != facet_num_nodes(type))
+    throw std::invalid_argument(to_string(type) + " cells need " +
+                                std::to_string(facet_num_nodes(type)) +
+                                " nodes");
+  return FacetSurface{ type,
+                       static_cast<int>(x.shape(1)),
+                       std::span<const double>(x.data(), x.size()),
+                       std::span<const std::int32_t>(cells.data(),
+                                                     cells.size()) };
+}
 
 std::span<const double>
 as_span(const array_t& a)
@@ -143,4 +174,126 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("element_mass"),
     py::arg("element_weights"),
     py::arg("nodal_weights"));
+
+  py::enum_<FacetType>(m, "FacetType")
+    .value("P1_line", FacetType::P1_line)
+    .value("P2_line", FacetType::P2_line)
+    .value("P1_triangle", FacetType::P1_triangle)
+    .value("P2_triangle", FacetType::P2_triangle)
+    .value("Q1_quadrilateral", FacetType::Q1_quadrilateral)
+    .value("Q2_quadrilateral", FacetType::Q2_quadrilateral)
+    .value("Q8_quadrilateral", FacetType::Q8_quadrilateral);
+
+  m.def(
+    "facet_shape_functions",
+    [](FacetType type, const array_t& X)
+    {
+      const int tdim = facet_tdim(type), nn = facet_num_nodes(type);
+      if (X.ndim() != 2 or X.shape(1) != tdim)
+        throw std::invalid_argument("X must have shape (points, tdim)");
+      std::vector<double> N(X.shape(0) * nn), dN(X.shape(0) * tdim * nn);
+      for (py::ssize_t i = 0; i < X.shape(0); ++i)
+        facet_shape_functions(type,
+                              std::span(X.data() + i * tdim, tdim),
+                              std::span(N.data() + i * nn, nn),
+                              std::span(dN.data() + i * tdim * nn, tdim * nn));
+      return py::make_tuple(to_numpy(N, { X.shape(0), nn }),
+                            to_numpy(dN, { X.shape(0), tdim, nn }));
+    },
+    py::arg("type"),
+    py::arg("X"),
+    "Shape functions (points, nodes) and reference gradients (points, "
+    "tdim, nodes)");
+
+  m.def(
+    "element_node_normals",
+    [](FacetType type, const array_t& x, const int_array_t& cells)
+    {
+      auto s = surface_view(type, x, cells);
+      return to_numpy(element_node_normals(s),
+                      { cells.shape(0), cells.shape(1), x.shape(1) });
+    },
+    py::arg("type"),
+    py::arg("x"),
+    py::arg("cells"));
+
+  m.def(
+    "facet_bounding_boxes",
+    [](
+      FacetType type, const array_t& x, const int_array_t& cells, double margin)
+    {
+      auto s = surface_view(type, x, cells);
+      return to_numpy(facet_bounding_boxes(s, margin), { cells.shape(0), 6 });
+    },
+    py::arg("type"),
+    py::arg("x"),
+    py::arg("cells"),
+    py::arg("margin"));
+
+  m.def(
+    "overlapping_box_pairs",
+    [](const array_t& a, const array_t& b)
+    {
+      auto pairs = overlapping_box_pairs(as_span(a), as_span(b));
+      return to_numpy_as<std::int32_t>(
+        pairs, { static_cast<py::ssize_t>(pairs.size() / 2), 2 });
+    },
+    py::arg("a"),
+    py::arg("b"),
+    "Pairs (i, j) of overlapping boxes, i in a, j in b; boxes (n, 6)");
+
+  m.def(
+    "mortar_integrals",
+    [](FacetType slave_type,
+       const array_t& xs,
+       const int_array_t& cs,
+       const array_t& slave_normals,
+       FacetType master_type,
+       const array_t& xm,
+       const int_array_t& cm,
+       const int_array_t& candidates,
+       const array_t& points,
+       const array_t& weights,
+       bool opposing_normals_only,
+       double relative_tolerance)
+    {
+      auto slave = surface_view(slave_type, xs, cs);
+      auto master = surface_view(master_type, xm, cm);
+      SegmentationOptions options{ opposing_normals_only, relative_tolerance };
+      MortarIntegrals r;
+      {
+        py::gil_scoped_release release;
+        r = mortar_integrals(
+          slave,
+          as_span(slave_normals),
+          master,
+          std::span<const std::int32_t>(candidates.data(), candidates.size()),
+          as_span(points),
+          as_span(weights),
+          options);
+      }
+      const auto np = static_cast<py::ssize_t>(r.area.size());
+      const py::ssize_t ns = cs.shape(1), nm = cm.shape(1);
+      py::dict out;
+      out["pairs"] = to_numpy_as<std::int32_t>(r.pairs, { np, 2 });
+      out["D"] = to_numpy(r.D, { np, ns, ns });
+      out["M"] = to_numpy(r.M, { np, ns, nm });
+      out["gap"] = to_numpy(r.gap, { np, ns });
+      out["area"] = to_numpy(r.area, { np });
+      out["failed_projections"] = r.failed_projections;
+      return out;
+    },
+    py::arg("slave_type"),
+    py::arg("slave_x"),
+    py::arg("slave_cells"),
+    py::arg("slave_normals"),
+    py::arg("master_type"),
+    py::arg("master_x"),
+    py::arg("master_cells"),
+    py::arg("candidates"),
+    py::arg("points"),
+    py::arg("weights"),
+    py::arg("opposing_normals_only") = true,
+    py::arg("relative_tolerance") = 1e-12,
+    "Segmentation and slave-basis mortar integrals per cell pair");
 }

@@ -1,0 +1,337 @@
+"""Mortar operators between a slave and a master surface (DESIGN.md §3–§4).
+
+:class:`MortarCoupling` segments one slave–master pair in one configuration and
+keeps the integrals in the slave basis N. Every mortar basis is ``M = N C`` on a
+slave cell, so :meth:`MortarCoupling.operators` turns them into the operators
+of any kind by ``Cᵀ·(…)`` without redoing the geometry:
+
+- ``D_AB = ∫ M_A N_B`` (slave × slave),
+- ``M_AC = ∫ M_A N^m_C∘χ`` (slave × master, master columns in the master
+  layout's global numbering),
+- ``g_A = ∫ M_A d`` with the gap ``d = (x_s − x_m)·n``, positive when penetrating.
+
+For GLS and GLS*, ``M_A`` has global support: their operators are
+``S·D_N``, ``S·M_N``, ``S·g_N`` with ``S = L⁻¹`` or ``W L⁻¹``, and only the
+sparse factors are assembled (DESIGN.md §3: never a dense slave block).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import basix
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar import _kernels
+from dolfinx_mortar.basis import MortarBasis
+from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
+from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.layout import NodeLayout, assemble_blocks
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+
+@dataclass
+class SurfaceCopy:
+    """What segmentation needs of a (possibly gathered) surface.
+
+    Attributes
+    ----------
+    facet_type
+        The kernels' facet type.
+    x
+        Node coordinates in the configuration of interest, (nodes, gdim).
+    cells
+        Node indices of each cell, (cells, nodes per cell).
+    global_ids
+        Global function index of each node in the surface's layout.
+    """
+
+    facet_type: _kernels.FacetType
+    x: FloatArray
+    cells: npt.NDArray[np.int32]
+    global_ids: IntArray
+
+
+def current_coordinates(surface: LagrangeSurface,
+                        displacement: Optional[FloatArray] = None) -> FloatArray:
+    """Node coordinates plus a nodal displacement (local nodes, gdim)."""
+    if displacement is None:
+        return surface.x
+    u = np.asarray(displacement, dtype=np.float64)
+    if u.shape != surface.x.shape:
+        raise ValueError(f"nodal displacement has shape {u.shape}, expected "
+                         f"{surface.x.shape} (local nodes, gdim)")
+    if not np.all(np.isfinite(u)):
+        raise ValueError("the displacement contains NaN or infinite values")
+    return surface.x + u
+
+
+def averaged_nodal_normals(surface: LagrangeSurface, x: FloatArray) -> FloatArray:
+    """Unit averages of the adjacent cells' normals at every local node.
+
+    Nodes on no cell get a zero vector. Summed across ranks, so a node shared
+    by facets on two ranks gets the same normal on both.
+    """
+    cell_normals = _kernels.element_node_normals(surface.facet_type, x,
+                                                 surface.cells.astype(np.int32))
+    summed = np.column_stack([surface.layout.sum_at_functions(surface.cells,
+                                                              cell_normals[..., k])
+                              for k in range(x.shape[1])])
+    length = np.linalg.norm(summed, axis=1)
+    return np.divide(summed, length[:, None], out=np.zeros_like(summed),
+                     where=length[:, None] > 0)
+
+
+def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
+    """All ranks' cells of a surface, with one copy of the nodes per cell.
+
+    The master side needs every master facet that may lie below this rank's
+    slave facets; gathering the (small) master surface is the simple way
+    (DESIGN.md §5 allows gathering or ghosting).
+    """
+    comm = surface.layout.comm
+    global_ids = surface.layout.global_indices[surface.cells]
+    coords = x[surface.cells]
+    if comm.size > 1:
+        global_ids = np.concatenate(comm.allgather(global_ids)).reshape(-1, surface.cells.shape[1])
+        coords = np.concatenate(comm.allgather(coords)).reshape(-1, *coords.shape[1:])
+    nc, nd = global_ids.shape
+    return SurfaceCopy(surface.facet_type, coords.reshape(nc * nd, -1),
+                       np.arange(nc * nd, dtype=np.int32).reshape(nc, nd),
+                       global_ids.ravel())
+
+
+def _polynomial_degree(surface: LagrangeSurface) -> int:
+    """Total degree of the basis in reference coordinates (Q_k: 2k)."""
+    k = surface.reference.degree
+    return 2 * k if surface.reference.cell == "quadrilateral" else k
+
+
+def _segment_quadrature(tdim: int, degree: int) -> tuple[FloatArray, FloatArray]:
+    cell = basix.CellType.interval if tdim == 1 else basix.CellType.triangle
+    return basix.make_quadrature(cell, degree)
+
+
+class MortarCoupling:
+    """Segmentation and slave-basis mortar integrals of a slave–master pair.
+
+    Parameters
+    ----------
+    slave, master
+        The surfaces; the slave's cells must be owned by this rank, the master
+        is gathered from all ranks.
+    slave_displacement, master_displacement
+        Nodal displacements (local nodes, gdim) giving the configuration;
+        ``None`` means the surfaces' own coordinates.
+    search_radius
+        How far apart facets may be and still be paired; default the largest
+        slave facet diameter.
+    quadrature_degree
+        Degree of the rule on each segment; the default integrates the
+        products of slave and master functions exactly on affine facets
+        (triangles, lines, parallelograms). On other quadrilaterals the
+        segments are mapped back through the bilinear inverse, the integrands
+        are not polynomials and the integrals are exact only up to quadrature.
+    opposing_normals_only
+        Skip master facets that face the same way as the slave facet.
+    """
+
+    def __init__(self, slave: LagrangeSurface, master: LagrangeSurface,
+                 slave_displacement: Optional[FloatArray] = None,
+                 master_displacement: Optional[FloatArray] = None,
+                 search_radius: Optional[float] = None,
+                 quadrature_degree: Optional[int] = None,
+                 opposing_normals_only: bool = True):
+        if slave.gdim != master.gdim:
+            raise ValueError(f"slave ({slave.gdim}D) and master ({master.gdim}D) surfaces "
+                             "live in different dimensions")
+        if slave.tdim != slave.gdim - 1 or master.tdim != master.gdim - 1:
+            raise ValueError("contact surfaces must be facets: lines in 2D, "
+                             "triangles or quadrilaterals in 3D")
+        self.slave, self.master = slave, master
+        comm = slave.layout.comm
+        xs = current_coordinates(slave, slave_displacement)
+        xm = current_coordinates(master, master_displacement)
+        self.normals = averaged_nodal_normals(slave, xs)
+        master_copy = gather_surface(master, xm)
+        self.master_global_ids = master_copy.global_ids
+        self.master_cells = master_copy.cells
+
+        if search_radius is None:
+            diam = np.max(np.ptp(xs[slave.cells], axis=1), initial=0.0)
+            search_radius = comm.allreduce(float(np.max(diam, initial=0.0)), op=MPI.MAX)
+        if not np.isfinite(search_radius) or search_radius < 0:
+            raise ValueError(f"search radius must be finite and non-negative, got {search_radius}")
+        self.search_radius = float(search_radius)
+        slave_cells = slave.cells.astype(np.int32)
+        slave_boxes = _kernels.facet_bounding_boxes(slave.facet_type, xs, slave_cells,
+                                                    self.search_radius)
+        master_boxes = _kernels.facet_bounding_boxes(master.facet_type, master_copy.x,
+                                                     master_copy.cells, 0.0)
+        candidates = _kernels.overlapping_box_pairs(slave_boxes, master_boxes)
+        degree = quadrature_degree or (_polynomial_degree(slave)
+                                       + max(_polynomial_degree(slave),
+                                             _polynomial_degree(master)))
+        points, weights = _segment_quadrature(slave.tdim, degree)
+        r = _kernels.mortar_integrals(slave.facet_type, xs, slave_cells, self.normals,
+                                      master.facet_type, master_copy.x, master_copy.cells,
+                                      candidates, points, weights, opposing_normals_only)
+        self.num_candidates = len(candidates)
+        self.failed_projections = comm.allreduce(int(r["failed_projections"]))
+        #: (pairs, 2) slave cell, master cell (index into the gathered master)
+        self.pairs = r["pairs"].astype(np.int64)
+        T = slave.reference.transform
+        if T is not None:
+            # integrals of the transformed basis Ñ = N T (DESIGN.md §2, hard spots)
+            self.D_pairs = np.einsum("ba,pbc,cd->pad", T, r["D"], T)
+            self.M_pairs = np.einsum("ba,pbc->pac", T, r["M"])
+            self.gap_pairs = np.einsum("ba,pb->pa", T, r["gap"])
+        else:
+            self.D_pairs, self.M_pairs, self.gap_pairs = r["D"], r["M"], r["gap"]
+        self.area_pairs = r["area"]
+        #: covered area of every local slave cell
+        self.covered_area = np.bincount(self.pairs[:, 0], weights=self.area_pairs,
+                                        minlength=len(slave.cells))
+        self._bases: dict[BasisKind, MortarBasis] = {}
+
+    @property
+    def total_covered_area(self) -> float:
+        """Covered slave area summed over all ranks."""
+        return self.slave.layout.comm.allreduce(float(np.sum(self.area_pairs)))
+
+    def basis(self, kind: KindLike) -> MortarBasis:
+        """The mortar basis of ``kind`` on the slave surface (cached)."""
+        kind = parse_kind(kind)
+        if kind not in self._bases:
+            self._bases[kind] = MortarBasis(kind, self.slave)
+        return self._bases[kind]
+
+    def _covered_coefficients(self, kind: BasisKind) -> FloatArray:
+        """Dual coefficients rebuilt on the covered part of every covered cell
+        (consistent boundary modification, Popp et al. 2013).
+
+        Fully covered cells get their usual coefficients back (up to roundoff);
+        rebuilding them too keeps LcLS's nodal W_A the same on every cell that
+        shares a node.
+        """
+        C = self.basis(kind).coefficients.copy()
+        nd = self.slave.cells.shape[1]
+        L_cov = np.zeros((len(self.slave.cells), nd, nd))
+        np.add.at(L_cov, self.pairs[:, 0], self.D_pairs)
+        W_cov = L_cov.sum(axis=2)  # Σ_B ∫_cov N_A N_B = ∫_cov N_A
+        W_nodal = self.slave.layout.sum_at_functions(self.slave.cells, W_cov)
+        covered = np.flatnonzero(self.covered_area > 0)
+        try:
+            C[covered] = _kernels.basis_coefficients(kind, L_cov[covered], W_cov[covered],
+                                                     W_nodal[self.slave.cells[covered]])
+        except ValueError as err:
+            raise ValueError(f"consistent boundary modification of {kind_name(kind)}: {err}"
+                             ) from None
+        return C
+
+    def operators(self, kind: KindLike, boundary_modification: bool = False
+                  ) -> "MortarOperators":
+        """Assembled mortar operators of one basis kind.
+
+        Parameters
+        ----------
+        kind
+            The basis kind.
+        boundary_modification
+            For the dual kinds (LcLS*, LcLS): rebuild the basis over the covered
+            part of partly covered slave cells.
+        """
+        kind = parse_kind(kind)
+        slave = self.slave
+        rows = slave.cells[self.pairs[:, 0]]
+        master_cols = self.master_global_ids[self.master_cells[self.pairs[:, 1]]]
+        basis = self.basis(kind)
+        if boundary_modification:
+            if kind not in (BasisKind.LcLS_star, BasisKind.LcLS):
+                raise ValueError("the consistent boundary modification applies to the dual "
+                                 f"kinds LcLS* and LcLS, not {kind_name(kind)}")
+            C = self._covered_coefficients(kind)
+        else:
+            C = basis.coefficients
+        if C is None:  # global kinds: integrals in N, applied through L⁻¹ later
+            D, M, g = self.D_pairs, self.M_pairs, self.gap_pairs
+        else:
+            Cp = C[self.pairs[:, 0]]
+            D = np.einsum("pba,pbc->pac", Cp, self.D_pairs)
+            M = np.einsum("pba,pbc->pac", Cp, self.M_pairs)
+            g = np.einsum("pba,pb->pa", Cp, self.gap_pairs)
+        master_layout = self.master.layout
+        D_mat = assemble_blocks(slave.layout, rows, slave.layout,
+                                slave.layout.global_indices[rows], D, unit_diagonal=True)
+        M_mat = assemble_blocks(slave.layout, rows, master_layout, master_cols, M)
+        gap = slave.layout.sum_at_functions(rows, g)
+        touched = slave.layout.sum_at_functions(rows, np.ones(rows.shape)) > 0
+        return MortarOperators(kind, basis, D_mat, M_mat, gap, touched)
+
+
+@dataclass
+class MortarOperators:
+    """Mortar operators of one kind.
+
+    For the local kinds ``D``, ``M`` and ``gap`` are the operators themselves.
+    For GLS/GLS* they are the slave-basis factors ``D_N``, ``M_N``, ``g_N``;
+    the operators are ``S·D_N`` etc. with ``S = L⁻¹`` (GLS) or ``W L⁻¹`` (GLS*),
+    applied by :meth:`nodal_gap` and :meth:`apply_S`. ``D`` carries a unit
+    diagonal on rows no segment touches.
+    """
+
+    kind: BasisKind
+    basis: MortarBasis
+    D: PETSc.Mat
+    M: PETSc.Mat
+    gap_factor: FloatArray
+    touched: npt.NDArray[np.bool_]
+
+    @property
+    def is_global(self) -> bool:
+        return is_global(self.kind)
+
+    def apply_S(self, values: FloatArray) -> FloatArray:
+        """``S v`` for the global kinds (identity for the local ones)."""
+        if not self.is_global:
+            return values
+        x = self.basis._solver.solve(values)
+        return x * self.basis.lumped_weights if self.kind == BasisKind.GLS_star else x
+
+    def nodal_gap(self) -> FloatArray:
+        """``g_A = ∫ M_A d`` at the local slave functions (zero off the contact)."""
+        return self.apply_S(self.gap_factor)
+
+    def transfer(self, master_values: PETSc.Vec) -> PETSc.Vec:
+        """Slave values ``u_s`` with ``D u_s = M u_m`` (the mortar projection).
+
+        For the global kinds ``S`` cancels, so ``D_N u_s = M_N u_m`` is solved.
+        Rows of slave functions no segment touches keep 0.
+        """
+        rhs = self.D.createVecLeft()
+        self.M.mult(master_values, rhs)
+        ksp = PETSc.KSP().create(self.D.comm)
+        ksp.setOperators(self.D)
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        ksp.getPC().setFactorSolverType("mumps")
+        ksp.setOptionsPrefix("dolfinx_mortar_transfer_")
+        ksp.setFromOptions()
+        out = self.D.createVecRight()
+        ksp.solve(rhs, out)
+        ksp.destroy()
+        return out
+
+
+def to_scipy(mat: PETSc.Mat):
+    """A serial PETSc AIJ matrix as a SciPy CSR matrix (for inspection)."""
+    import scipy.sparse
+    if mat.comm.size > 1:
+        raise ValueError("to_scipy needs a serial matrix; gather first")
+    indptr, indices, data = mat.getValuesCSR()
+    return scipy.sparse.csr_matrix((data, indices, indptr), shape=mat.getSize())

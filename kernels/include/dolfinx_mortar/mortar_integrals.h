@@ -1,0 +1,64 @@
+// Copyright (C) 2026 dolfinx_mortar developers
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "surface_geometry.h"
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace dolfinx_mortar
+{
+
+/// Mortar integrals of slave–master cell pairs, in the slave basis N.
+///
+/// Every mortar basis is M = N C on a slave cell (C the cell's coefficient
+/// matrix), so the integrals of any kind follow from these by Cᵀ·(…):
+/// this kernel does the geometry once for all six kinds.
+struct MortarIntegrals
+{
+  std::vector<std::int32_t> pairs;     ///< (pairs, 2): slave cell, master cell
+  std::vector<double> D;               ///< (pairs, ns, ns): ∫ N_A N_B
+  std::vector<double> M;               ///< (pairs, ns, nm): ∫ N_A N^m_C∘χ
+  std::vector<double> gap;             ///< (pairs, ns): ∫ N_A d
+  std::vector<double> area;            ///< (pairs): covered area
+  std::int64_t failed_projections = 0; ///< Newton failures (points skipped)
+};
+
+/// Options of the segmentation.
+struct SegmentationOptions
+{
+  /// Skip master facets whose normal does not oppose the slave's.
+  bool opposing_normals_only = true;
+  /// Overlaps smaller than this fraction of the slave sub-facet are dropped.
+  double relative_tolerance = 1e-12;
+};
+
+/// Segment candidate slave–master cell pairs and integrate on the segments.
+///
+/// Per slave sub-facet (the facet itself for linear facets; 2 or 4 flat
+/// pieces for quadratic ones): an auxiliary plane (line in 2D) through its
+/// centre with its normal n₀; master sub-facets are projected onto it along
+/// n₀ and clipped with it; the clip polygon is triangulated from its centroid
+/// and integrated with the given rule; each point is projected back along n₀
+/// onto the slave and the master cells (Newton). The gap is
+/// d = (x_s − x_m)·n with n the interpolated averaged nodal normal.
+///
+/// @param[in] slave, master The surfaces (current configuration)
+/// @param[in] slave_normals Averaged unit nodal normals (slave nodes, gdim)
+/// @param[in] candidates Cell pairs to test, row-major (pairs, 2)
+/// @param[in] points Quadrature points on the reference interval [0, 1]
+/// (2D) or triangle (3D), row-major (points, gdim − 1)
+/// @param[in] weights Quadrature weights (sum 1 or ½)
+/// @param[in] options Segmentation options
+/// @return Integrals of the pairs that overlap
+MortarIntegrals
+mortar_integrals(const FacetSurface& slave,
+                 std::span<const double> slave_normals,
+                 const FacetSurface& master,
+                 std::span<const std::int32_t> candidates,
+                 std::span<const double> points,
+                 std::span<const double> weights,
+                 const SegmentationOptions& options);
+
+} // namespace dolfinx_mortar

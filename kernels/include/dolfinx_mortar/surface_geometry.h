@@ -1,0 +1,74 @@
+// Copyright (C) 2026 dolfinx_mortar developers
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "facet_element.h"
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace dolfinx_mortar
+{
+
+/// A facet surface as plain arrays. Node ordering within a cell is Basix's,
+/// oriented so that the natural normal points out of the body:
+/// 2D n = (t_y, -t_x) with t = dx/dX; 3D n = ∂x/∂X₀ × ∂x/∂X₁.
+struct FacetSurface
+{
+  FacetType type;
+  int gdim;                            ///< 2 or 3
+  std::span<const double> x;           ///< node coordinates (nodes, gdim)
+  std::span<const std::int32_t> cells; ///< (cells, nodes per cell)
+
+  std::size_t num_cells() const { return cells.size() / facet_num_nodes(type); }
+  /// Throws std::invalid_argument if the arrays do not fit together.
+  void check() const;
+};
+
+using Point3 = std::array<double, 3>;
+
+/// Position x(X) and tangents ∂x/∂X_k (2D: z = 0) of cell @p c.
+void
+facet_geometry(const FacetSurface& s,
+               std::size_t c,
+               std::span<const double> X,
+               std::span<double> N,
+               std::span<double> dN,
+               Point3& x,
+               std::array<Point3, 2>& tangents);
+
+/// Unit normal from tangents (2D: only tangents[0] is used).
+Point3
+normal_from_tangents(int gdim, const std::array<Point3, 2>& tangents);
+
+/// Reference coordinates of the nodes, row-major (nodes, tdim).
+std::vector<double>
+facet_reference_nodes(FacetType type);
+
+/// Unit normal of each cell at each of its nodes, (cells, nodes, gdim).
+/// Averaging them per node gives the averaged nodal normals of DESIGN.md §3.
+std::vector<double>
+element_node_normals(const FacetSurface& s);
+
+/// Bounding box of each cell's nodes enlarged by @p margin, (cells, 6).
+std::vector<double>
+facet_bounding_boxes(const FacetSurface& s, double margin);
+
+/// Result of projecting a point along a direction onto a facet.
+struct Projection
+{
+  std::array<double, 2> X; ///< reference coordinates
+  double t;                ///< x(X) = p + t·direction
+  bool converged;
+};
+
+/// Solve x(X) = p + t·direction for (X, t) by Newton's method from @p X0.
+Projection
+project_along(const FacetSurface& s,
+              std::size_t c,
+              const Point3& p,
+              const Point3& direction,
+              std::array<double, 2> X0);
+
+} // namespace dolfinx_mortar
