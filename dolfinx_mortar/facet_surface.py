@@ -107,3 +107,26 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     normals = surface.cell_normals().mean(axis=1)
     inward = np.einsum("cg,cg->c", normals, facet_centres - cell_centres) < 0
     return surface.reflected(inward) if np.any(inward) else surface
+
+
+def nodal_displacement(surface: LagrangeSurface, u: fem.Function) -> np.ndarray:
+    """Values of a vector Function at the surface's local nodes, (nodes, gdim).
+
+    ``u`` must live on a space with the surface's node numbering: the space
+    the surface was built from, or its vector version on the same mesh.
+    """
+    space = u.function_space
+    index_map = space.dofmap.index_map
+    bs = space.dofmap.index_map_bs
+    if (index_map.size_local != surface.layout.num_owned
+            or index_map.num_ghosts != len(surface.layout.ghosts)):
+        raise ValueError("the displacement's function space numbers its nodes differently "
+                         "from the surface; build the surface from this space")
+    if bs != surface.gdim:
+        raise ValueError(f"the displacement has {bs} components per node, the surface "
+                         f"lives in {surface.gdim}D")
+    u.x.scatter_forward()
+    values = u.x.array.reshape(-1, bs)
+    if not np.all(np.isfinite(values)):
+        raise ValueError("the displacement contains NaN or infinite values")
+    return values.copy()

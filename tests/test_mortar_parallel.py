@@ -1,0 +1,121 @@
+"""Mortar operators of two DOLFINx meshes in contact, on 1 and 2 ranks.
+
+Run under ``mpirun -n 2``: the distributed D and M are compared entry by entry
+(matched by node coordinates) with a serial computation on COMM_SELF copies.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from dolfinx import fem, mesh
+from mpi4py import MPI
+from scipy.spatial import cKDTree
+
+from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
+from dolfinx_mortar.mortar import MortarCoupling
+
+SLAVE, MASTER = 1, 2
+
+
+def two_blocks(comm, dim, degree):
+    """A lower block (slave face on top) and a coarser, shifted upper block."""
+    if dim == 2:
+        lower = mesh.create_rectangle(comm, [[0, -0.5], [1, 0]], [7, 3],
+                                      cell_type=mesh.CellType.triangle)
+        upper = mesh.create_rectangle(comm, [[0.3, 0.0], [1.4, 0.5]], [4, 2],
+                                      cell_type=mesh.CellType.quadrilateral)
+    else:
+        lower = mesh.create_box(comm, [[0, 0, -0.5], [1, 1, 0]], [5, 4, 2],
+                                cell_type=mesh.CellType.tetrahedron)
+        upper = mesh.create_box(comm, [[0.3, -0.2, 0], [1.4, 0.8, 0.5]], [3, 3, 2],
+                                cell_type=mesh.CellType.hexahedron)
+    out = []
+    for domain, tag, where in ((lower, SLAVE, 0.0), (upper, MASTER, 0.0)):
+        fdim = dim - 1
+        facets = mesh.locate_entities_boundary(domain, fdim,
+                                               lambda x: np.isclose(x[dim - 1], where))
+        tags = mesh.meshtags(domain, fdim, np.sort(facets).astype(np.int32),
+                             np.full(len(facets), tag, dtype=np.int32))
+        V = fem.VectorFunctionSpace(domain, ("Lagrange", degree))
+        out.append((V, tags))
+    return out
+
+
+def entries(mat, row_coords, col_coords):
+    """All (row xyz, col xyz, value) of a distributed matrix, on every rank."""
+    lo, _ = mat.getOwnershipRange()
+    indptr, indices, data = mat.getValuesCSR()
+    rows = np.repeat(np.arange(len(indptr) - 1) + lo, np.diff(indptr))
+    # roundoff-level entries (e.g. the dual D's off-diagonal) exist or are exactly
+    # zero depending on summation order: compare only the significant ones
+    scale = mat.comm.tompi4py().allreduce(np.max(np.abs(data), initial=0.0), op=MPI.MAX)
+    keep = np.abs(data) > 1e-13 * scale
+    local = np.hstack([row_coords[rows[keep]], col_coords[indices[keep]], data[keep, None]])
+    return np.vstack(mat.comm.tompi4py().allgather(local))
+
+
+def global_coordinates(V):
+    """Coordinates of every node by global index, on every rank."""
+    im = V.dofmap.index_map
+    n = im.size_local
+    x = V.tabulate_dof_coordinates()[:n]
+    ids = np.arange(im.local_range[0], im.local_range[1])
+    all_x = np.vstack(V.mesh.comm.allgather(x))
+    all_ids = np.concatenate(V.mesh.comm.allgather(ids))
+    out = np.empty_like(all_x)
+    out[all_ids] = all_x
+    return out
+
+
+def operators(comm, dim, degree, kind):
+    (Vs, ts), (Vm, tm) = two_blocks(comm, dim, degree)
+    slave = facet_surface(Vs, ts, SLAVE)
+    master = facet_surface(Vm, tm, MASTER)
+    u = fem.Function(Vm)  # push the master down by 0.01 + 0.02 x: a tilted contact
+    u.interpolate(lambda x: np.vstack([np.zeros_like(x[0])] * (dim - 1)
+                                      + [-0.01 - 0.02 * x[0]]))
+    c = MortarCoupling(slave, master, master_displacement=nodal_displacement(master, u))
+    op = c.operators(kind)
+    xs, xm = global_coordinates(Vs), global_coordinates(Vm)
+    gap = op.nodal_gap()[: slave.layout.num_owned]
+    gaps = np.vstack(comm.allgather(np.hstack([
+        Vs.tabulate_dof_coordinates()[: slave.layout.num_owned], gap[:, None]])))
+    return (entries(op.D, xs, xs), entries(op.M, xs, xm), gaps,
+            c.total_covered_area, comm.allgather(len(slave.cells)))
+
+
+def same(a, b, tol):
+    """Entry sets equal up to tol (matched by coordinates)."""
+    assert a.shape == b.shape, (a.shape, b.shape)
+    keys = a.shape[1] - 1
+    tree = cKDTree(b[:, :keys])
+    distance, index = tree.query(a[:, :keys])
+    assert np.max(distance) < 1e-10
+    assert len(np.unique(index)) == len(index)
+    scale = np.max(np.abs(b[:, -1]))
+    assert np.max(np.abs(a[:, -1] - b[index, -1])) <= tol * scale
+
+
+@pytest.mark.parametrize("dim, degree", [(2, 1), (2, 2), (3, 1)])
+@pytest.mark.parametrize("kind", ["LcLS*", "GLS", "LmLS"])
+def test_operators_agree_on_one_and_all_ranks(dim, degree, kind):
+    D, M, gap, area, counts = operators(MPI.COMM_WORLD, dim, degree, kind)
+    D0, M0, gap0, area0, _ = operators(MPI.COMM_SELF, dim, degree, kind)
+    assert min(counts) > 0  # every rank owns slave facets: the parallel path is used
+    expected = 0.7 if dim == 2 else 0.7 * 0.8
+    assert area == pytest.approx(expected, rel=1e-12) and area0 == pytest.approx(expected, rel=1e-12)
+    same(D, D0, 1e-12)
+    same(M, M0, 1e-12)
+    same(gap, gap0, 1e-10)
+    # the master moved down 0.01 + 0.02 x onto the slave at z = 0: penetrating,
+    # which the positive LmLS functions show at every covered node
+    covered = gap0[:, -1] != 0
+    if kind == "LmLS":
+        assert np.all(gap0[covered, -1] > 0)
+
+
+def test_wrong_displacement_space_is_reported():
+    (Vs, ts), (Vm, tm) = two_blocks(MPI.COMM_WORLD, 2, 1)
+    slave = facet_surface(Vs, ts, SLAVE)
+    with pytest.raises(ValueError, match="numbers its nodes differently"):
+        nodal_displacement(slave, fem.Function(Vm))
