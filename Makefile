@@ -14,13 +14,14 @@ DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 	libeigen3-dev python3-pytest python3-matplotlib python3-scipy python3-tqdm \
 	python3-dev cmake g++ make libgtest-dev openmpi-bin
 
-.PHONY: help setup deps build install demo test test-cpp test-python test-mpi bench clean
+.PHONY: help setup deps build install demo test test-cpp test-python test-mpi bench stress clean
 
 help:
 	@echo "make setup  - install missing Debian packages, build the kernels, make dolfinx_mortar importable"
 	@echo "make demo   - setup, then the main demo (figures 1 and 2) into results/"
 	@echo "make test   - setup, then C++ tests (ctest), pytest, and pytest under mpirun -n 2"
 	@echo "make bench  - setup, then the benchmarks in benchmarks/"
+	@echo "make stress - setup, then 1e6 generated slave-master pairs through 3D segmentation"
 
 setup: deps build install
 
@@ -66,6 +67,9 @@ test-mpi:
 
 bench: setup
 	$(PYTHON) benchmarks/bench_basis_construction.py
+
+stress: setup
+	$(BUILD_DIR)/kernels/stress_segmentation 1000000 1
 
 clean:
 	rm -rf $(BUILD_DIR) dolfinx_mortar/_kernels*.so

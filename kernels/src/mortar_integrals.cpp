@@ -68,11 +68,17 @@ make_subfacet(const FacetSurface& s,
       f.reference_centre[k] += X[k] / reference.size();
   }
   const auto& P = f.polygon;
+  // Degenerate pieces are judged relative to their extent: collinear points
+  // give a cross product of roundoff size, not exactly zero.
+  double extent = 0;
+  for (const Point3& p : P)
+    extent = std::max(extent, norm(sub(p, P[0])));
+  constexpr double degenerate = 1e-12;
   if (s.gdim == 2)
   {
     const Point3 t = sub(P[1], P[0]);
     f.size = norm(t);
-    if (!(f.size > 0))
+    if (!(f.size > 0) or f.size <= 1e-14 * norm(P[0]))
       return std::nullopt;
     f.e1 = { t[0] / f.size, t[1] / f.size, 0 };
     f.normal = { f.e1[1], -f.e1[0], 0 };
@@ -82,7 +88,7 @@ make_subfacet(const FacetSurface& s,
   Point3 n = P.size() == 3 ? cross(sub(P[1], P[0]), sub(P[2], P[0]))
                            : cross(sub(P[2], P[0]), sub(P[3], P[1]));
   const double n_norm = norm(n);
-  if (!(n_norm > 0))
+  if (!(n_norm > degenerate * extent * extent))
     return std::nullopt;
   for (double& v : n)
     v /= n_norm;
