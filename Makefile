@@ -67,6 +67,7 @@ test-mpi:
 
 bench: setup
 	$(PYTHON) benchmarks/bench_basis_construction.py
+	$(PYTHON) benchmarks/bench_segmentation.py
 
 stress: setup
 	$(BUILD_DIR)/kernels/stress_segmentation 1000000 1

@@ -16,6 +16,7 @@ sparse factors are assembled (DESIGN.md §3: never a dense slave block).
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from typing import Optional
 
@@ -154,11 +155,16 @@ class MortarCoupling:
             raise ValueError("contact surfaces must be facets: lines in 2D, "
                              "triangles or quadrilaterals in 3D")
         self.slave, self.master = slave, master
+        #: wall time in seconds of each phase on this rank
+        self.timings: dict[str, float] = {}
+        clock = time.perf_counter()
         comm = slave.layout.comm
         xs = current_coordinates(slave, slave_displacement)
         xm = current_coordinates(master, master_displacement)
         self.normals = averaged_nodal_normals(slave, xs)
         master_copy = gather_surface(master, xm)
+        self.timings["normals_and_gather"] = time.perf_counter() - clock
+        clock = time.perf_counter()
         self.master_global_ids = master_copy.global_ids
         self.master_cells = master_copy.cells
 
@@ -174,6 +180,8 @@ class MortarCoupling:
         master_boxes = _kernels.facet_bounding_boxes(master.facet_type, master_copy.x,
                                                      master_copy.cells, 0.0)
         candidates = _kernels.overlapping_box_pairs(slave_boxes, master_boxes)
+        self.timings["search"] = time.perf_counter() - clock
+        clock = time.perf_counter()
         degree = quadrature_degree or (_polynomial_degree(slave)
                                        + max(_polynomial_degree(slave),
                                              _polynomial_degree(master)))
@@ -181,6 +189,7 @@ class MortarCoupling:
         r = _kernels.mortar_integrals(slave.facet_type, xs, slave_cells, self.normals,
                                       master.facet_type, master_copy.x, master_copy.cells,
                                       candidates, points, weights, opposing_normals_only)
+        self.timings["segmentation"] = time.perf_counter() - clock
         self.num_candidates = len(candidates)
         self.failed_projections = comm.allreduce(int(r["failed_projections"]))
         #: (pairs, 2) slave cell, master cell (index into the gathered master)
