@@ -3,7 +3,9 @@
 # another one that cannot import DOLFINx.
 PYTHON ?= /usr/bin/python3
 BUILD_DIR ?= build
-MPIRUN ?= mpirun -n 2 --oversubscribe
+# A failure on one rank can leave the other waiting in a collective: the
+# timeout turns such a hang into a failure instead of a stuck CI run.
+MPIRUN ?= timeout 1800 mpirun -n 2 --oversubscribe
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 # Keep OpenMP/BLAS threads from fighting the MPI ranks on a 2-core machine.
@@ -60,10 +62,10 @@ test-cpp:
 	cd $(BUILD_DIR) && ctest --output-on-failure
 
 test-python:
-	$(PYTHON) -m pytest -q tests
+	$(PYTHON) -m pytest -q --color=no tests
 
 test-mpi:
-	$(MPIRUN) $(PYTHON) -m pytest -q -p no:cacheprovider tests
+	$(MPIRUN) $(PYTHON) -m pytest -q --color=no -p no:cacheprovider tests
 
 bench: setup
 	$(PYTHON) benchmarks/bench_basis_construction.py

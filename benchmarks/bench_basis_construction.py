@@ -42,10 +42,10 @@ from dolfinx_mortar import KIND_NAMES, MortarBasis, _kernels, nurbs
 from dolfinx_mortar.kinds import is_global, parse_kind
 from dolfinx_mortar.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import MassMatrixSolver
+from dolfinx_mortar.output import save_figure, write_atomically
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
-DEFAULT_CSV = REPO_ROOT / "results" / "bench_basis_construction.csv"
-DEFAULT_PNG = REPO_ROOT / "results" / "bench_basis_construction.png"
+DEFAULT_CSV = Path("results/bench_basis_construction.csv")
+DEFAULT_PNG = Path("results/bench_basis_construction.png")
 
 #: Phase names in the order the constructor runs them.
 PHASES: tuple[str, ...] = ("tabulate", "kernels", "W", "coeffs/L asm", "factorize")
@@ -170,6 +170,7 @@ def time_phases(kind: str, surface: Any) -> tuple[float, ...]:
     solver = None
     if is_global(basis_kind):
         matrix = layout.assemble_matrix(cells, element_mass)
+        matrix.setOption(matrix.Option.SYMMETRIC, True)
         lap()
         solver = MassMatrixSolver(layout, matrix)
         lap()
@@ -310,14 +311,16 @@ def _groups(results: list[RunResult]) -> dict[tuple[str, str], list[RunResult]]:
 
 def write_csv(results: list[RunResult], path: Path) -> None:
     """One row per run: all :class:`RunResult` fields plus derived columns (seconds)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
     names = [f.name for f in fields(RunResult)]
-    with path.open("w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(names + ["us_per_element", "phase_sum"])
-        for r in results:
-            writer.writerow([getattr(r, name) if getattr(r, name) is not None else ""
-                             for name in names] + [r.us_per_element, r.phase_sum])
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(names + ["us_per_element", "phase_sum"])
+            for r in results:
+                writer.writerow([getattr(r, name) if getattr(r, name) is not None else ""
+                                 for name in names] + [r.us_per_element, r.phase_sum])
+    write_atomically(path, write)
 
 
 def write_png(results: list[RunResult], path: Path) -> None:
@@ -326,7 +329,6 @@ def write_png(results: list[RunResult], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    path.parent.mkdir(parents=True, exist_ok=True)
     surfaces = list(dict.fromkeys(r.surface for r in results))
     fig, axes = plt.subplots(1, len(surfaces), figsize=(6 * len(surfaces), 4.5),
                              squeeze=False, sharey=False)
@@ -345,7 +347,7 @@ def write_png(results: list[RunResult], path: Path) -> None:
         ax.legend()
     fig.suptitle("MortarBasis construction time per slave element")
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
+    save_figure(path, fig, dpi=150)
     plt.close(fig)
 
 

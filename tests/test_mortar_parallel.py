@@ -119,3 +119,59 @@ def test_wrong_displacement_space_is_reported():
     slave = facet_surface(Vs, ts, SLAVE)
     with pytest.raises(ValueError, match="numbers its nodes differently"):
         nodal_displacement(slave, fem.Function(Vm))
+
+
+def one_mesh_two_bodies(comm):
+    """Two rectangles in one gmsh model, meshed independently (non-matching):
+    lower [0,1]x[-0.5,0] (slave on top, h=0.1), upper [0.2,1.3]x[0,0.4] (master at
+    the bottom, h=0.17)."""
+    import gmsh
+    from dolfinx.io import gmshio
+    gmsh.initialize(["", "-v", "0"])
+    try:
+        if comm.rank == 0:
+            occ = gmsh.model.occ
+            lower = occ.addRectangle(0, -0.5, 0, 1, 0.5)
+            upper = occ.addRectangle(0.2, 0, 0, 1.1, 0.4)
+            occ.synchronize()
+            gmsh.model.addPhysicalGroup(2, [lower], 1)
+            gmsh.model.addPhysicalGroup(2, [upper], 2)
+            for surface, tag, y in ((lower, SLAVE, 0.0), (upper, MASTER, 0.0)):
+                edges = [e[1] for e in gmsh.model.getBoundary([(2, surface)], oriented=False)
+                         if abs(gmsh.model.occ.getCenterOfMass(1, e[1])[1] - y) < 1e-9]
+                gmsh.model.addPhysicalGroup(1, edges, tag)
+            for surface, h in ((lower, 0.1), (upper, 0.17)):
+                points = gmsh.model.getBoundary([(2, surface)], recursive=True)
+                gmsh.model.mesh.setSize(points, h)
+            gmsh.model.mesh.generate(2)
+        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+    finally:
+        gmsh.finalize()
+    return domain, facet_tags
+
+
+def test_one_mesh_with_two_bodies():
+    results = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        domain, tags = one_mesh_two_bodies(comm)
+        V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+        slave, master = facet_surface(V, tags, SLAVE), facet_surface(V, tags, MASTER)
+        c = MortarCoupling(slave, master)
+        assert c.total_covered_area == pytest.approx(0.8, rel=1e-12)
+        op = c.operators("LcLS*")
+        x = global_coordinates(V)
+        # a linear field on the master is reproduced on the covered slave nodes
+        um = op.M.createVecRight()
+        lo, hi = um.getOwnershipRange()
+        um.array[:] = 1 + 2 * x[lo:hi, 0]
+        us = op.transfer(um)
+        n = slave.layout.num_owned
+        xs = V.tabulate_dof_coordinates()[:n]
+        on_slave = np.zeros(slave.layout.size_local, dtype=bool)
+        on_slave[slave.cells] = True
+        # nodes whose whole support is covered (the master starts at x = 0.2, h = 0.1)
+        inside = on_slave[:n] & (xs[:, 0] > 0.2 + 0.1 + 1e-12)
+        assert np.max(np.abs(us.array[inside] - (1 + 2 * xs[inside, 0])), initial=0) < 1e-12
+        results.append((entries(op.M, x, x), c.slave.layout.comm.allgather(len(slave.cells))))
+    (M, counts), (M0, _) = results
+    same(M, M0, 1e-12)
