@@ -28,6 +28,7 @@ import argparse
 import csv
 import gc
 import math
+import os
 import resource
 import sys
 import time
@@ -384,6 +385,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if not sizes:
         print("no decade between --min-elements and --max-elements", file=sys.stderr)
         return 1
+    load_at_start = os.getloadavg()[0]
     warm_up(args.kinds)
     results: list[RunResult] = []
     with tqdm(total=len(args.surfaces) * len(sizes) * len(args.kinds), file=sys.stderr,
@@ -411,6 +413,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     print()
     print(f"peak RSS: {peak:.2f} GiB"
           + ("" if peak <= MEMORY_LIMIT_GIB else f"  (above the {MEMORY_LIMIT_GIB} GiB budget)"))
+    # This process adds ~1 to the load; more means other work shared the cores.
+    print(f"1-min load average: {load_at_start:.2f} at start, "
+          f"{os.getloadavg()[0]:.2f} at end ({os.cpu_count()} cores)")
     print(f"wrote {args.csv} and {args.png}")
     return 0
 

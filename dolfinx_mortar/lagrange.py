@@ -241,11 +241,17 @@ class LagrangeSurface:
         J = np.einsum("ntk,nkg->ngt", dN, coords)
         return N, x, _surface_measure(J)
 
-    def tabulate(self, quadrature_degree: Optional[int] = None) -> Tabulation:
-        """Basis values, weights·|J| and points at a Basix rule on every facet."""
+    def tabulate(self, quadrature_degree: Optional[int] = None,
+                 transformed: bool = True) -> Tabulation:
+        """Basis values, weights·|J| and points at a Basix rule on every facet.
+
+        ``transformed=False`` gives the standard Lagrange basis even when the
+        surface uses the transformed quadratic basis (displacements are always
+        interpolated in the standard one).
+        """
         q = quadrature_degree or self.default_quadrature_degree()
         X, wq = basix.make_quadrature(self.reference.cell_type, q)
-        N, dN = self.reference.tabulate(X)
+        N, dN = self.reference.tabulate(X, transformed=transformed)
         N_geo, _ = self.reference.tabulate(X, transformed=False)
         coords = self.x[self.cells]  # (nc, nd, gdim)
         points = np.einsum("qk,ckg->cqg", N_geo, coords)

@@ -194,6 +194,8 @@ class MortarCoupling:
         self.failed_projections = comm.allreduce(int(r["failed_projections"]))
         #: (pairs, 2) slave cell, master cell (index into the gathered master)
         self.pairs = r["pairs"].astype(np.int64)
+        #: integrals of the standard slave basis N per pair: ∫N N, ∫N N^m, ∫N d
+        self.raw_pairs = (r["D"], r["M"], r["gap"])
         T = slave.reference.transform
         if T is not None:
             # integrals of the transformed basis Ñ = N T (DESIGN.md §2, hard spots)

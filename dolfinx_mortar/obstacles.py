@@ -1,0 +1,118 @@
+"""Rigid analytic obstacles: they are never meshed (DESIGN.md §3).
+
+An obstacle is its signed distance φ (positive outside the obstacle), with the
+gradient and Hessian the exact contact Jacobian needs. The penetration of a
+slave point x is d = −φ(x).
+"""
+from __future__ import annotations
+
+from typing import Protocol, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+
+
+class RigidObstacle(Protocol):
+    """What the contact terms need of a rigid obstacle. ``x`` has shape (n, gdim)."""
+
+    gdim: int
+
+    def signed_distance(self, x: FloatArray) -> FloatArray: ...
+
+    def gradient(self, x: FloatArray) -> FloatArray: ...
+
+    def hessian(self, x: FloatArray) -> FloatArray: ...
+
+
+def _vector(v: Sequence[float], name: str) -> FloatArray:
+    a = np.asarray(v, dtype=np.float64)
+    if a.ndim != 1 or len(a) not in (2, 3) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be a finite 2D or 3D vector, got {v!r}")
+    return a
+
+
+class RigidPlane:
+    """The half-space behind a plane through ``point`` with outward ``normal``.
+
+    The normal points out of the obstacle, into the space where the body is.
+    """
+
+    def __init__(self, point: Sequence[float], normal: Sequence[float]):
+        self.point = _vector(point, "point")
+        n = _vector(normal, "normal")
+        if len(n) != len(self.point):
+            raise ValueError("point and normal differ in dimension")
+        length = np.linalg.norm(n)
+        if length == 0:
+            raise ValueError("the plane's normal is zero")
+        self.normal = n / length
+        self.gdim = len(n)
+
+    def signed_distance(self, x: FloatArray) -> FloatArray:
+        return (x - self.point) @ self.normal
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        return np.broadcast_to(self.normal, x.shape).copy()
+
+    def hessian(self, x: FloatArray) -> FloatArray:
+        return np.zeros((len(x), self.gdim, self.gdim))
+
+
+class RigidSphere:
+    """A solid ball (a disk in 2D: the section of a rigid cylinder)."""
+
+    def __init__(self, center: Sequence[float], radius: float):
+        self.center = _vector(center, "center")
+        if not radius > 0:
+            raise ValueError(f"the radius must be positive, got {radius}")
+        self.radius = float(radius)
+        self.gdim = len(self.center)
+
+    def signed_distance(self, x: FloatArray) -> FloatArray:
+        return np.linalg.norm(x - self.center, axis=1) - self.radius
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        r = x - self.center
+        return r / np.linalg.norm(r, axis=1)[:, None]
+
+    def hessian(self, x: FloatArray) -> FloatArray:
+        r = x - self.center
+        length = np.linalg.norm(r, axis=1)
+        unit = r / length[:, None]
+        eye = np.eye(self.gdim)[None]
+        return (eye - unit[:, :, None] * unit[:, None, :]) / length[:, None, None]
+
+
+class RigidCylinder:
+    """A solid circular cylinder in 3D with an axis through ``point`` along ``axis``."""
+
+    def __init__(self, point: Sequence[float], axis: Sequence[float], radius: float):
+        self.point = _vector(point, "point")
+        a = _vector(axis, "axis")
+        if len(a) != 3 or len(self.point) != 3:
+            raise ValueError("RigidCylinder is 3D; in 2D use RigidSphere (a disk)")
+        self.axis = a / np.linalg.norm(a)
+        if not radius > 0:
+            raise ValueError(f"the radius must be positive, got {radius}")
+        self.radius = float(radius)
+        self.gdim = 3
+
+    def _radial(self, x: FloatArray) -> FloatArray:
+        r = x - self.point
+        return r - np.outer(r @ self.axis, self.axis)
+
+    def signed_distance(self, x: FloatArray) -> FloatArray:
+        return np.linalg.norm(self._radial(x), axis=1) - self.radius
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        r = self._radial(x)
+        return r / np.linalg.norm(r, axis=1)[:, None]
+
+    def hessian(self, x: FloatArray) -> FloatArray:
+        r = self._radial(x)
+        length = np.linalg.norm(r, axis=1)
+        unit = r / length[:, None]
+        P = np.eye(3) - np.outer(self.axis, self.axis)
+        return (P[None] - unit[:, :, None] * unit[:, None, :]) / length[:, None, None]

@@ -1,0 +1,464 @@
+"""The penalty mortar contact problem on DOLFINx (DOLFINx 0.5.2 API).
+
+Small-strain linear elasticity (plane strain in 2D) through UFL, penalty mortar
+contact against a rigid analytic obstacle or an elastic master in the same
+mesh, Newton through PETSc SNES (options prefix ``dolfinx_mortar_``), load steps
+that are cut back when Newton fails, and XDMF output after every converged step.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+import ufl
+from dolfinx import fem, io
+from dolfinx.fem import petsc as fem_petsc
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar.contact_terms import MortarGap, ObstacleGap, gap_kind
+from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
+from dolfinx_mortar.kinds import KindLike, kind_name, parse_kind
+from dolfinx_mortar.mortar import MortarCoupling
+from dolfinx_mortar.obstacles import RigidObstacle
+
+FloatArray = npt.NDArray[np.float64]
+
+ACTIVE_SETS = ("nodal", "pointwise")
+CONFIGURATIONS = ("initial", "previous", "current")
+
+#: PETSc options set unless the options database already has them
+DEFAULT_OPTIONS = {
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "basic",
+    "snes_rtol": 1e-9,
+    "snes_atol": 1e-10,
+    "snes_stol": 0.0,
+    "snes_max_it": 30,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+
+class ContactDivergenceError(RuntimeError):
+    """Newton failed at a load step even after the step was cut back.
+
+    Attributes
+    ----------
+    load_factor
+        The load factor that could not be reached.
+    history
+        One (load factor, SNES reason, residual norms) entry per failed attempt.
+    """
+
+    def __init__(self, load_factor: float, history: list):
+        self.load_factor = load_factor
+        self.history = history
+        lines = [f"  load {lf:.6g}: SNES reason {reason}, residuals "
+                 + ", ".join(f"{r:.3e}" for r in res) for lf, reason, res in history]
+        super().__init__(f"Newton diverged at load factor {load_factor:.6g} after "
+                         f"{len(history)} attempts:\n" + "\n".join(lines))
+
+
+@dataclass
+class StepResult:
+    """One converged load step."""
+
+    load_factor: float
+    newton_iterations: int
+    residuals: list
+    wall_time: float
+    active_nodes: int
+
+
+@dataclass
+class SolveResult:
+    """All converged steps and the final state."""
+
+    steps: list = field(default_factory=list)
+
+    @property
+    def newton_iterations(self) -> int:
+        return sum(s.newton_iterations for s in self.steps)
+
+
+class ContactProblem:
+    """A linear elastic body (or two in one mesh) in penalty mortar contact.
+
+    Parameters
+    ----------
+    V
+        Vector Lagrange function space of degree 1 or 2 for the displacement.
+    facet_tags
+        Facet meshtags.
+    slave_tag
+        Tag of the slave facets.
+    master_tag
+        Tag of the master facets in the same mesh (two bodies), or None.
+    obstacle
+        A rigid analytic obstacle instead of a master surface.
+    E, nu
+        Young's modulus and Poisson's ratio.
+    kind
+        Mortar basis kind (local kinds: LmLS, LmLS*, LcLS*, LcLS).
+    penalty
+        ε, pressure per length (consistent scaling).
+    scaling
+        ``"consistent"`` (default) or ``"seed"``.
+    active_set
+        ``"nodal"`` (default); ``"pointwise"`` is not implemented yet.
+    basis_configuration
+        ``"initial"`` (default): bases and segmentation in the reference
+        configuration; ``"previous"``: the elastic master is re-segmented in
+        the last converged configuration at every load step.
+    fixed
+        ``{tag: {component: value}}``: prescribed displacement components at
+        load factor 1 (scaled by the load factor).
+    tractions
+        ``{tag: vector}``: surface tractions at load factor 1.
+    quadratic_transform
+        Transformed basis on quadratic triangle facets.
+    """
+
+    def __init__(self, V: fem.FunctionSpace, facet_tags, slave_tag: int, *,
+                 master_tag: Optional[int] = None, obstacle: Optional[RigidObstacle] = None,
+                 E: float, nu: float, kind: KindLike = "LcLS*", penalty: float,
+                 scaling: str = "consistent", active_set: str = "nodal",
+                 basis_configuration: str = "initial",
+                 fixed: Optional[dict] = None, tractions: Optional[dict] = None,
+                 quadratic_transform: bool = False):
+        mesh = V.mesh
+        gdim = mesh.geometry.dim
+        if V.dofmap.index_map_bs != gdim:
+            raise ValueError(f"V must be a vector space with {gdim} components per node")
+        if (master_tag is None) == (obstacle is None):
+            raise ValueError("give exactly one of master_tag (elastic master) and obstacle "
+                             "(rigid analytic obstacle)")
+        if not (E > 0 and -1 < nu < 0.5):
+            raise ValueError(f"need E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
+        if active_set not in ACTIVE_SETS:
+            raise ValueError(f"unknown active set '{active_set}'; expected {ACTIVE_SETS}")
+        if active_set == "pointwise":
+            raise NotImplementedError("the pointwise active set (elements split at d = 0) "
+                                      "is not implemented yet; use active_set='nodal'")
+        if basis_configuration not in CONFIGURATIONS:
+            raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
+                             f"expected {CONFIGURATIONS}")
+        if basis_configuration == "current":
+            raise NotImplementedError("basis_configuration='current' needs the finite-"
+                                      "deformation linearization; not implemented yet")
+        if obstacle is not None and obstacle.gdim != gdim:
+            raise ValueError(f"a {obstacle.gdim}D obstacle in a {gdim}D mesh: the option "
+                             "does not fit the mesh's dimension")
+        gap_kind(kind, scaling)  # validates kind and scaling early
+        fixed, tractions = fixed or {}, tractions or {}
+        present = {int(t) for values in mesh.comm.allgather(np.unique(facet_tags.values))
+                   for t in values}
+        for tag in [slave_tag, master_tag, *fixed, *tractions]:
+            if tag is not None and tag not in present:
+                raise ValueError(f"facet tag {tag} marks no facets (tags present: "
+                                 f"{sorted(present)})")
+        if master_tag is not None:
+            a, b = facet_tags.find(slave_tag), facet_tags.find(master_tag)
+            if mesh.comm.allreduce(len(np.intersect1d(a, b))) > 0:
+                raise ValueError(f"slave tag {slave_tag} and master tag {master_tag} "
+                                 "overlap: a facet cannot be both")
+        self.V, self.mesh = V, mesh
+        self.kind = parse_kind(kind)
+        self.penalty, self.scaling = float(penalty), scaling
+        self.basis_configuration = basis_configuration
+        self.obstacle = obstacle
+        self.load = fem.Constant(mesh, PETSc.ScalarType(0.0))
+
+        # bulk: small strain, plane strain in 2D
+        mu = E / (2 * (1 + nu))
+        lmbda = E * nu / ((1 + nu) * (1 - 2 * nu))
+        self.u = fem.Function(V, name="displacement")
+        v, du = ufl.TestFunction(V), ufl.TrialFunction(V)
+
+        def eps(w):
+            return ufl.sym(ufl.grad(w))
+
+        def sigma(w):
+            return 2 * mu * eps(w) + lmbda * ufl.tr(eps(w)) * ufl.Identity(gdim)
+
+        ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
+        F = ufl.inner(sigma(self.u), eps(v)) * ufl.dx
+        for tag, t in tractions.items():
+            t = np.asarray(t, dtype=np.float64)
+            if t.shape != (gdim,):
+                raise ValueError(f"traction on tag {tag} must have {gdim} components")
+            F -= self.load * ufl.inner(ufl.as_vector([float(c) for c in t]), v) * ds(tag)
+        self.F_form = fem.form(F)
+        self.J_form = fem.form(ufl.derivative(F, self.u, du))
+
+        fdim = mesh.topology.dim - 1
+        self._bc_values = []
+        self.bcs = []
+        for tag, components in fixed.items():
+            facets = facet_tags.find(tag)
+            for k, value in components.items():
+                if not 0 <= k < gdim:
+                    raise ValueError(f"component {k} does not exist in {gdim}D")
+                dofs = fem.locate_dofs_topological(V.sub(k), fdim, facets)
+                c = fem.Constant(mesh, PETSc.ScalarType(0.0))
+                self._bc_values.append((c, float(value)))
+                self.bcs.append(fem.dirichletbc(c, dofs, V.sub(k)))
+
+        self.slave = facet_surface(V, facet_tags, slave_tag, quadratic_transform)
+        self.master = (facet_surface(V, facet_tags, master_tag) if master_tag is not None
+                       else None)
+        self.gap_model: Union[ObstacleGap, MortarGap]
+        self._segment(None)
+        self.b = fem_petsc.create_vector(self.F_form)
+        self.A_bulk = fem_petsc.create_matrix(self.J_form)
+        self.timings: dict[str, float] = {}
+        self._output: Optional[Path] = None
+
+    # -- contact -------------------------------------------------------------------
+    def _segment(self, u_nodes: Optional[FloatArray]) -> None:
+        """(Re)build the gap model; for an elastic master in the configuration u."""
+        clock = time.perf_counter()
+        if self.obstacle is not None:
+            self.gap_model = ObstacleGap(self.slave, self.obstacle, self.kind, self.penalty,
+                                         self.scaling)
+        else:
+            coupling = MortarCoupling(self.slave, self.master, u_nodes, u_nodes)
+            self.gap_model = MortarGap(coupling, self.kind, self.penalty, self.scaling)
+        self._A_total: Optional[PETSc.Mat] = None
+        self._bc_mask: Optional[PETSc.Vec] = None
+        self.timings_segmentation = time.perf_counter() - clock
+
+    def _mask(self) -> PETSc.Vec:
+        """1 on free dofs, 0 on Dirichlet dofs (the contact terms skip those)."""
+        if self._bc_mask is None:
+            m = self.b.duplicate()
+            m.set(1.0)
+            fem_petsc.set_bc(m, self.bcs, scale=0.0)
+            self._bc_mask = m
+        return self._bc_mask
+
+    def _contact(self) -> tuple[FloatArray, PETSc.Mat, Optional[PETSc.Mat]]:
+        """Nodal gaps, masked G and masked curvature matrix at the current u."""
+        if isinstance(self.gap_model, ObstacleGap):
+            u_nodes = nodal_displacement(self.slave, self.u)
+            gaps, G, x = self.gap_model.evaluate(u_nodes)
+            coefficient = self.gap_model.weights * np.maximum(gaps, 0.0)
+            blocks = self.gap_model.curvature_blocks(coefficient, x)
+            K_curv = None
+            if blocks is not None:
+                from dolfinx_mortar.layout import assemble_blocks
+                gm = self.gap_model
+                dofs = gm._node_dofs(self.slave.cells).reshape(len(self.slave.cells), -1)
+                local = (self.slave.cells[..., None] * self.slave.gdim
+                         + np.arange(self.slave.gdim)).reshape(len(self.slave.cells), -1)
+                K_curv = assemble_blocks(gm.dofs, local, gm.dofs, dofs, blocks)
+                K_curv.diagonalScale(self._mask(), self._mask())
+        else:
+            G = self.gap_model.G.copy()
+            gaps = self.gap_model.evaluate(self.u.vector)
+            K_curv = None
+        G.diagonalScale(None, self._mask())
+        return gaps, G, K_curv
+
+    # -- SNES callbacks --------------------------------------------------------------
+    def _residual(self, snes, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        clock = time.perf_counter()
+        x.copy(self.u.vector)
+        self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with b.localForm() as local:
+            local.set(0.0)
+        fem_petsc.assemble_vector(b, self.F_form)
+        fem_petsc.apply_lifting(b, [self.J_form], [self.bcs], x0=[x], scale=-1.0)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self._add("bulk_residual", clock)
+        clock = time.perf_counter()
+        gaps, G, K_curv = self._contact()
+        self._state = (gaps, G, K_curv)
+        force = self.slave.layout.vector(self.gap_model.weights * np.maximum(gaps, 0.0))
+        Rc = G.createVecRight()
+        G.multTranspose(force, Rc)
+        b.axpy(1.0, Rc)
+        self._add("contact_residual", clock)
+        fem_petsc.set_bc(b, self.bcs, x, -1.0)
+
+    def _jacobian(self, snes, x: PETSc.Vec, J: PETSc.Mat, P: PETSc.Mat) -> None:
+        clock = time.perf_counter()
+        self.A_bulk.zeroEntries()
+        fem_petsc.assemble_matrix(self.A_bulk, self.J_form, self.bcs)
+        self.A_bulk.assemble()
+        self._add("bulk_jacobian", clock)
+        clock = time.perf_counter()
+        gaps, G, K_curv = self._state
+        # Generalized derivative of ⟨·⟩ at 0 taken as 1: touching nodes (d̄ = 0, as
+        # at the start of every contact problem) stiffen without pushing, so
+        # the first Jacobian is not singular.
+        active = self.slave.layout.vector(self.gap_model.weights * (gaps >= 0))
+        SG = G.copy()
+        SG.diagonalScale(active, None)
+        Kc = G.transposeMatMult(SG)
+        J.zeroEntries()
+        J.axpy(1.0, self.A_bulk, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        J.axpy(1.0, Kc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        if K_curv is not None:
+            J.axpy(1.0, K_curv, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        J.assemble()
+        self._add("contact_jacobian", clock)
+
+    def _add(self, name: str, since: float) -> None:
+        self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
+
+    def _total_matrix(self) -> PETSc.Mat:
+        """Bulk pattern ∪ contact pattern, built once per segmentation."""
+        if self._A_total is None:
+            self._residual(None, self.u.vector, self.b)
+            gaps, G, K_curv = self._state
+            A = self.A_bulk.duplicate(copy=False)
+            fem_petsc.assemble_matrix(A, self.J_form, self.bcs)
+            A.assemble()
+            Kc = G.transposeMatMult(G)
+            A.axpy(1.0, Kc, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            if K_curv is not None:
+                A.axpy(1.0, K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            self._A_total = A
+        return self._A_total
+
+    # -- driver ----------------------------------------------------------------------
+    def _snes(self, prefix: str) -> PETSc.SNES:
+        opts = PETSc.Options()
+        for key, value in DEFAULT_OPTIONS.items():
+            if not opts.hasName(prefix + key):
+                opts[prefix + key] = value
+        snes = PETSc.SNES().create(self.mesh.comm)
+        snes.setOptionsPrefix(prefix)
+        snes.setFunction(self._residual, self.b)
+        snes.setJacobian(self._jacobian, self._total_matrix())
+        snes.setConvergenceHistory()
+        snes.setFromOptions()
+        return snes
+
+    def _set_load(self, factor: float) -> None:
+        self.load.value = factor
+        for c, value in self._bc_values:
+            c.value = factor * value
+
+    def solve(self, load_steps: int = 1, output: Optional[Union[str, Path]] = None,
+              max_cuts: int = 5, progress: bool = False,
+              prefix: str = "dolfinx_mortar_",
+              on_step: Optional[Callable[["ContactProblem", StepResult], None]] = None
+              ) -> SolveResult:
+        """Apply the load in ``load_steps`` equal steps.
+
+        A step whose Newton solve fails is halved and retried, at most
+        ``max_cuts`` times in a row; then :class:`ContactDivergenceError` is
+        raised with the residual history. Each converged step is written to
+        ``output`` (XDMF) before the next one starts.
+        """
+        if load_steps < 1:
+            raise ValueError("load_steps must be at least 1")
+        if not np.all(np.isfinite(self.u.x.array)):
+            raise ValueError("the displacement contains NaN or infinite values")
+        if output is not None:
+            self._open_output(Path(output))
+        snes = self._snes(prefix)
+        result = SolveResult()
+        reached, step = 0.0, 1.0 / load_steps
+        failures: list = []
+        bar = None
+        if progress and self.mesh.comm.rank == 0:
+            from tqdm import tqdm
+            bar = tqdm(total=load_steps, desc="load steps", unit="step")
+        x = self.u.vector.copy()
+        while reached < 1.0 - 1e-12:
+            target = min(1.0, reached + step)
+            self._set_load(target)
+            saved = self.u.vector.copy()
+            clock = time.perf_counter()
+            x = self.u.vector.copy()
+            snes.setConvergenceHistory(reset=True)
+            snes.solve(None, x)
+            reason = snes.getConvergedReason()
+            history = list(snes.getConvergenceHistory()[0])
+            if reason <= 0:
+                failures.append((target, reason, history))
+                if len(failures) > max_cuts:
+                    raise ContactDivergenceError(target, failures)
+                saved.copy(self.u.vector)
+                self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT,
+                                          mode=PETSc.ScatterMode.FORWARD)
+                step /= 2
+                continue
+            failures = []
+            x.copy(self.u.vector)
+            self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT,
+                                      mode=PETSc.ScatterMode.FORWARD)
+            gaps = self.nodal_gaps()
+            active = self.mesh.comm.allreduce(int(np.sum(gaps[: self.slave.layout.num_owned] > 0)))
+            s = StepResult(target, snes.getIterationNumber(), history,
+                           time.perf_counter() - clock, active)
+            result.steps.append(s)
+            reached = target
+            if bar is not None:
+                bar.update(step * load_steps)
+            if output is not None:
+                self._write_step(target)
+            if on_step is not None:
+                on_step(self, s)
+            if self.basis_configuration == "previous" and self.master is not None:
+                self._segment(nodal_displacement(self.slave, self.u))
+                snes.destroy()
+                snes = self._snes(prefix)
+        if bar is not None:
+            bar.close()
+        snes.destroy()
+        return result
+
+    # -- results ---------------------------------------------------------------------
+    def nodal_gaps(self) -> FloatArray:
+        """``d̄_A`` at the local slave-layout nodes for the current u."""
+        if isinstance(self.gap_model, ObstacleGap):
+            gaps, _, _ = self.gap_model.evaluate(nodal_displacement(self.slave, self.u))
+            return gaps
+        return self.gap_model.evaluate(self.u.vector)
+
+    def nodal_pressures(self) -> FloatArray:
+        """Contact pressure ``p_A = ε⟨d̄_A⟩`` (consistent scaling) at local nodes."""
+        return self.gap_model.nodal_pressures(self.nodal_gaps())
+
+    def _open_output(self, path: Path) -> None:
+        if path.suffix != ".xdmf":
+            raise ValueError(f"output must be an .xdmf file, got {path}")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self._output = path
+        with io.XDMFFile(self.mesh.comm, str(path), "w") as f:
+            f.write_mesh(self.mesh)
+
+    def _write_step(self, t: float) -> None:
+        """Append the step, reopening the file so that it is complete on disk."""
+        u1, p_hat = self._output_functions()
+        with io.XDMFFile(self.mesh.comm, str(self._output), "a") as f:
+            f.write_function(u1, t)
+            f.write_function(p_hat, t)
+
+    def _output_functions(self) -> tuple[fem.Function, fem.Function]:
+        mesh = self.mesh
+        if not hasattr(self, "_out_spaces"):
+            V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", mesh.geometry.cmap.degree))
+            Q, q_to_v = self.V.sub(0).collapse()
+            self._out_spaces = (V1, Q, np.asarray(q_to_v) // self.V.dofmap.index_map_bs)
+        V1, Q, q_nodes = self._out_spaces
+        u1 = fem.Function(V1, name="displacement")
+        u1.interpolate(self.u)
+        p = fem.Function(Q, name="contact_pressure")
+        p.x.array[:] = self.nodal_pressures()[q_nodes]
+        if Q.ufl_element().degree() != mesh.geometry.cmap.degree:
+            Q1 = fem.FunctionSpace(mesh, ("Lagrange", mesh.geometry.cmap.degree))
+            p1 = fem.Function(Q1, name="contact_pressure")
+            p1.interpolate(p)
+            p = p1
+        return u1, p
