@@ -38,7 +38,10 @@ DEFAULT_OPTIONS = {
     "snes_rtol": 1e-9,
     "snes_atol": 1e-10,
     "snes_stol": 0.0,
-    "snes_max_it": 30,
+    "snes_max_it": 40,
+    # the first step of a contact problem often overshoots into the obstacle
+    # before the active set settles: do not call that divergence
+    "snes_divergence_tolerance": -1,
     "ksp_type": "preonly",
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
@@ -295,10 +298,7 @@ class ContactProblem:
         self._add("bulk_jacobian", clock)
         clock = time.perf_counter()
         gaps, G, K_curv = self._state
-        # Generalized derivative of ⟨·⟩ at 0 taken as 1: touching nodes (d̄ = 0, as
-        # at the start of every contact problem) stiffen without pushing, so
-        # the first Jacobian is not singular.
-        active = self.slave.layout.vector(self.gap_model.weights * (gaps >= 0))
+        active = self.slave.layout.vector(self.gap_model.weights * self._active(gaps))
         SG = G.copy()
         SG.diagonalScale(active, None)
         Kc = G.transposeMatMult(SG)
@@ -309,6 +309,26 @@ class ContactProblem:
             J.axpy(1.0, K_curv, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         J.assemble()
         self._add("contact_jacobian", clock)
+
+    def _active(self, gaps: FloatArray) -> FloatArray:
+        """Nodes that get contact stiffness in the Jacobian (H(d̄) as 0/1).
+
+        The generalized derivative of ⟨·⟩ at 0 is taken as 1, so touching
+        nodes stiffen without pushing. If no node on any rank is active — a
+        body that only touches at a point, with positive mortar functions, has
+        d̄ < 0 everywhere — the nodes within a tenth of their element length
+        of contact get stiffness too: otherwise the rigid-body mode that the
+        contact must hold makes the Jacobian singular. Once a node is active
+        the Jacobian is exact again.
+        """
+        active = gaps >= 0
+        n = self.slave.layout.num_owned
+        on_surface = self.gap_model.basis.lumped_weights > 0
+        if self.mesh.comm.allreduce(int(np.sum(active[:n] & on_surface[:n]))) == 0:
+            W = self.gap_model.basis.lumped_weights
+            length = np.power(np.maximum(W, 0.0), 1.0 / self.slave.tdim)
+            active = on_surface & (gaps >= -0.1 * length)
+        return active.astype(np.float64)
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since

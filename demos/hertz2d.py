@@ -1,0 +1,212 @@
+"""Hertz 2D: an elastic cylinder (plane strain) pressed onto a rigid plane or an elastic block.
+
+A quarter of the cylinder (radius R, centre (0, R); symmetry u_x = 0 at x = 0)
+carries the line load F (per unit thickness) as a uniform traction F/(2R) on its
+diametral edge y = R. The rigid plane y = 0 is analytic, not meshed; with
+``--obstacle elastic`` the cylinder presses onto an elastic block
+[0, 2R] × [−2R, 0] of the same material in the same mesh (fixed at its bottom).
+The mesh (gmsh) is graded towards the contact with size a/n_c at the contact,
+a the Hertz half-width and n_c = 40·refine.
+
+Hertz (plane strain): E* = E/(1−ν²) (rigid plane) or E/(2(1−ν²)) (two equal
+bodies), a = sqrt(4FR/(πE*)), p0 = 2F/(πa), p(x) = p0 sqrt(1 − x²/a²).
+
+    /usr/bin/python3 demos/hertz2d.py --json results/hertz2d.json
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from typing import Optional, Sequence
+
+import numpy as np
+from mpi4py import MPI
+
+from dolfinx_mortar.output import write_json
+
+SLAVE, MASTER, SYMMETRY, LOAD, FIXED = 1, 2, 3, 4, 5
+
+
+def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--radius", type=float, default=1.0, help="cylinder radius R (1)")
+    parser.add_argument("--E", type=float, default=1.0, help="Young's modulus (1)")
+    parser.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
+    parser.add_argument("--force", type=float, default=0.01,
+                        help="line load F per unit thickness (0.01: a ≈ 0.11 R)")
+    parser.add_argument("--refine", type=float, default=1.0,
+                        help="mesh density factor: contact size a/(40·refine) (1)")
+    parser.add_argument("--degree", type=int, default=1, choices=(1, 2),
+                        help="displacement degree (1)")
+    parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
+    parser.add_argument("--scaling", default="consistent", choices=("consistent", "seed"))
+    parser.add_argument("--penalty", type=float, default=1e3,
+                        help="penalty ε as a multiple of E/h_contact (1e3)")
+    parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"))
+    parser.add_argument("--load-steps", type=int, default=4, help="load steps (4)")
+    parser.add_argument("--output", default=None, help="XDMF file for the steps")
+    parser.add_argument("--json", default=None, help="write the key figures as JSON here")
+    return parser.parse_args(argv)
+
+
+def hertz(args) -> dict:
+    E_star = args.E / (1 - args.nu ** 2)
+    if args.obstacle == "elastic":
+        E_star /= 2
+    a = np.sqrt(4 * args.force * args.radius / (np.pi * E_star))
+    return {"E_star": E_star, "a": a, "p0": 2 * args.force / (np.pi * a)}
+
+
+def build_mesh(args, a: float, comm: MPI.Comm):
+    """Quarter disk (and block), graded towards the contact point (0, 0)."""
+    import gmsh
+    from dolfinx.io import gmshio
+    R = args.radius
+    h_contact = a / (40 * args.refine)
+    gmsh.initialize(["", "-v", "0"])
+    try:
+        if comm.rank == 0:
+            occ = gmsh.model.occ
+            disk = occ.addDisk(0, R, 0, R, R)
+            box = occ.addRectangle(0, 0, 0, R, R)
+            quarter, _ = occ.intersect([(2, disk)], [(2, box)])
+            surfaces = [quarter[0][1]]
+            if args.obstacle == "elastic":
+                surfaces.append(occ.addRectangle(0, -2 * R, 0, 2 * R, 2 * R))
+            occ.synchronize()
+            tags: dict = {SLAVE: [], MASTER: [], SYMMETRY: [], LOAD: [], FIXED: []}
+            tol = 1e-6 * R
+            for _, curve in gmsh.model.getEntities(1):
+                x, y, _ = occ.getCenterOfMass(1, curve)
+                if abs(x) < tol:
+                    tags[SYMMETRY].append(curve)      # x = 0 of cylinder and block
+                elif abs(y - R) < tol:
+                    tags[LOAD].append(curve)
+                elif abs(y) < tol:
+                    tags[MASTER].append(curve)        # top of the block
+                elif abs(y + 2 * R) < tol:
+                    tags[FIXED].append(curve)
+                elif y > 0:
+                    tags[SLAVE].append(curve)         # the arc
+            for tag, curves in tags.items():
+                if curves:
+                    gmsh.model.addPhysicalGroup(1, curves, tag)
+            for i, s in enumerate(surfaces):
+                gmsh.model.addPhysicalGroup(2, [s], 10 + i)
+            field = gmsh.model.mesh.field
+            point = occ.addPoint(0, 0, 0)
+            occ.synchronize()
+            field.add("Distance", 1)
+            field.setNumbers(1, "PointsList", [point])
+            field.add("Threshold", 2)
+            field.setNumber(2, "InField", 1)
+            field.setNumber(2, "SizeMin", h_contact)
+            field.setNumber(2, "SizeMax", R / 8)
+            field.setNumber(2, "DistMin", 1.5 * a)
+            field.setNumber(2, "DistMax", 1.5 * a + 40 * (R / 8))
+            field.setAsBackgroundMesh(2)
+            gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+            gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+            gmsh.model.mesh.generate(2)
+            if args.degree == 2:
+                gmsh.model.mesh.setOrder(2)
+        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+    finally:
+        gmsh.finalize()
+    return domain, facet_tags, h_contact
+
+
+def contact_results(problem, ref: dict) -> dict:
+    """Peak pressure, half-width (least squares of p² against x²) and the L2 error."""
+    comm = problem.mesh.comm
+    slave = problem.slave
+    n = slave.layout.num_owned
+    p = problem.nodal_pressures()
+    on_slave = np.zeros(slave.layout.size_local, dtype=bool)
+    on_slave[slave.cells] = True
+    x = slave.x[:, 0]
+    mine = on_slave[:n] & (p[:n] > 0)
+    xs = np.concatenate(comm.allgather(x[:n][mine]))
+    ps = np.concatenate(comm.allgather(p[:n][mine]))
+    p0 = float(np.max(ps))
+    # p² = p0²(1 − x²/a²) is linear in x²: fit it over the inner 90% of the zone
+    inner = xs < 0.9 * np.max(xs)
+    c1, c0 = np.polyfit(xs[inner] ** 2, ps[inner] ** 2, 1)
+    a_fit = float(np.sqrt(-c0 / c1)) if c1 < 0 < c0 else float("nan")
+    # L2 error of p̂ = Σ N_A p_A over [0, a_Hertz] on the slave quadrature points
+    tab = problem.gap_model.basis.tabulation if hasattr(problem.gap_model, "basis") else None
+    tab = slave.tabulate(6, transformed=False)
+    p_hat = np.einsum("cqb,cb->cq", tab.phi, p[slave.cells])
+    xq = tab.points[..., 0]
+    exact = ref["p0"] * np.sqrt(np.maximum(0.0, 1 - (xq / ref["a"]) ** 2))
+    near = (xq < 1.5 * ref["a"]) & (tab.points[..., 1] < 0.5 * problem_radius(problem))
+    err2 = comm.allreduce(float(np.sum((tab.weights * (p_hat - exact) ** 2)[near])))
+    ref2 = comm.allreduce(float(np.sum((tab.weights * exact ** 2)[near])))
+    total = comm.allreduce(float(np.sum(problem.gap_model.weights[:n]
+                                        * np.maximum(problem.nodal_gaps()[:n], 0))))
+    return {"p0": p0, "a": a_fit, "a_last_active_node": float(np.max(xs)),
+            "l2_error": float(np.sqrt(err2 / ref2)), "contact_force": total,
+            "active_nodes": int(len(xs))}
+
+
+def problem_radius(problem) -> float:
+    return float(problem.mesh.comm.allreduce(np.max(problem.mesh.geometry.x[:, 1]),
+                                             op=MPI.MAX))
+
+
+def main(argv: Optional[Sequence[str]] = None) -> dict:
+    args = parse_args(argv)
+    from dolfinx import fem
+    from dolfinx_mortar.obstacles import RigidPlane
+    from dolfinx_mortar.problem import ContactProblem
+    comm = MPI.COMM_WORLD
+    ref = hertz(args)
+    clock = time.perf_counter()
+    domain, facet_tags, h_contact = build_mesh(args, ref["a"], comm)
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", args.degree))
+    fixed = {SYMMETRY: {0: 0.0}}
+    kwargs = {}
+    if args.obstacle == "rigid":
+        kwargs["obstacle"] = RigidPlane([0.0, 0.0], [0.0, 1.0])
+    else:
+        kwargs["master_tag"] = MASTER
+        fixed[FIXED] = {0: 0.0, 1: 0.0}
+    problem = ContactProblem(V, facet_tags, SLAVE, E=args.E, nu=args.nu, kind=args.kind,
+                             penalty=args.penalty * args.E / h_contact, scaling=args.scaling,
+                             fixed=fixed,
+                             tractions={LOAD: [0.0, -args.force / (2 * args.radius)]},
+                             **kwargs)
+    result = problem.solve(load_steps=args.load_steps, output=args.output,
+                           progress=comm.rank == 0)
+    wall = time.perf_counter() - clock
+    figures = contact_results(problem, ref)
+    dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+    figures.update({
+        "hertz_p0": ref["p0"], "hertz_a": ref["a"],
+        "p0_error": figures["p0"] / ref["p0"] - 1, "a_error": figures["a"] / ref["a"] - 1,
+        "force_error": figures["contact_force"] / (args.force / 2) - 1,
+        "dofs": int(dofs), "newton_iterations": result.newton_iterations,
+        "load_steps": len(result.steps), "wall_time": wall, "h_contact": h_contact,
+        "kind": args.kind, "scaling": args.scaling, "obstacle": args.obstacle,
+        "degree": args.degree, "refine": args.refine, "ranks": comm.size,
+    })
+    if comm.rank == 0:
+        print(f"Hertz 2D ({args.obstacle} obstacle, {args.kind}, P{args.degree}, "
+              f"{dofs} dofs, {comm.size} rank(s))")
+        print(f"  peak pressure p0 = {figures['p0']:.6g}  (Hertz {ref['p0']:.6g}, "
+              f"error {100 * figures['p0_error']:+.3f}%)")
+        print(f"  half-width a     = {figures['a']:.6g}  (Hertz {ref['a']:.6g}, "
+              f"error {100 * figures['a_error']:+.3f}%)")
+        print(f"  L2 error of the pressure over the contact zone: "
+              f"{100 * figures['l2_error']:.3f}%")
+        print(f"  contact force / applied: {1 + figures['force_error']:.8f}")
+        print(f"  Newton iterations {result.newton_iterations} in {len(result.steps)} steps, "
+              f"wall time {wall:.2f} s")
+    if args.json and comm.rank == 0:
+        write_json(args.json, figures)
+    return figures
+
+
+if __name__ == "__main__":
+    main()
