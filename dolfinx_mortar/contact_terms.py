@@ -27,7 +27,8 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.basis import MortarBasis
-from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind, unstarred_partner
+from dolfinx_mortar.kinds import (BasisKind, KindLike, is_global, is_partition_of_unity,
+                                  kind_name, parse_kind, unstarred_partner)
 from dolfinx_mortar.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar import MortarCoupling
@@ -79,10 +80,18 @@ class _GapBase:
         self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
 
     def nodal_pressures(self, gaps: FloatArray) -> FloatArray:
-        """``p_A = ω_A ⟨d̄_A⟩ / W_A``: a pressure in the consistent scaling."""
+        """Pressure coefficients ``p_A`` of the contact traction in a PU basis.
+
+        The traction is ``Σ_A ω_A ⟨d_A⟩ M_A`` with ``M`` the gap basis. A non-PU
+        ``M_A`` is ``M*_A / W_A``, so ``p_A = ω_A ⟨d_A⟩ / W_A`` (in the
+        consistent scaling ``ε⟨d̄_A⟩``); a PU gap basis (seed scaling with a
+        starred kind) gives ``p_A = ω_A ⟨d_A⟩`` directly.
+        """
+        force = self.weights * np.maximum(gaps, 0.0)
+        if is_partition_of_unity(self.basis.kind):
+            return force
         W = self.basis.lumped_weights
-        return np.divide(self.weights * np.maximum(gaps, 0.0), W, out=np.zeros_like(W),
-                         where=W > 0)
+        return np.divide(force, W, out=np.zeros_like(W), where=W > 0)
 
     def _node_dofs(self, nodes: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
         """Global dofs (node·bs + k) of local nodes, shape nodes.shape + (bs,)."""
