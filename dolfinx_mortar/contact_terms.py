@@ -129,7 +129,7 @@ class ObstacleGap(_GapBase):
         x = (tab.points + u_q).reshape(-1, self.slave.gdim)
         nc, nq, nd = tab.phi.shape
         d = -self.obstacle.signed_distance(x).reshape(nc, nq)
-        nu = self.obstacle.gradient(x).reshape(nc, nq, -1)
+        nu = self.obstacle.gradient(x).reshape(nc, nq, self.slave.gdim)
         wd = tab.weights * d
         gaps = self.slave.layout.sum_at_functions(cells, np.einsum("cqa,cq->ca", self.Mbar, wd))
         # ∂d̄_A/∂u_(B,k) = −Σ_q w M̄_A ν_k N_B
@@ -183,9 +183,11 @@ class MortarGap(_GapBase):
         blocks = np.concatenate([np.einsum("pab,pak->pabk", Dg, n),
                                  -np.einsum("pac,pak->pack", Mg, n)], axis=2)
         npairs, ns = slave_cells.shape
-        cols = np.concatenate([slave_dofs, master_dofs], axis=1).reshape(npairs, -1)
+        # explicit sizes: a rank may own no pair, and reshape(0, -1) is ambiguous
+        width = (ns + master_nodes.shape[1]) * bs
+        cols = np.concatenate([slave_dofs, master_dofs], axis=1).reshape(npairs, width)
         self.G = assemble_blocks(self.slave.layout, slave_cells, self.dofs, cols,
-                                 blocks.reshape(npairs, ns, -1))
+                                 blocks.reshape(npairs, ns, width))
 
     def evaluate(self, u: PETSc.Vec) -> FloatArray:
         """Nodal gaps at the local slave nodes for the displacement vector ``u``."""

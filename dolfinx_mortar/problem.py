@@ -257,9 +257,11 @@ class ContactProblem:
             if blocks is not None:
                 from dolfinx_mortar.layout import assemble_blocks
                 gm = self.gap_model
-                dofs = gm._node_dofs(self.slave.cells).reshape(len(self.slave.cells), -1)
+                nc, nd = self.slave.cells.shape
+                width = nd * self.slave.gdim
+                dofs = gm._node_dofs(self.slave.cells).reshape(nc, width)
                 local = (self.slave.cells[..., None] * self.slave.gdim
-                         + np.arange(self.slave.gdim)).reshape(len(self.slave.cells), -1)
+                         + np.arange(self.slave.gdim)).reshape(nc, width)
                 K_curv = assemble_blocks(gm.dofs, local, gm.dofs, dofs, blocks)
                 K_curv.diagonalScale(self._mask(), self._mask())
         else:

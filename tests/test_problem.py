@@ -1,0 +1,211 @@
+"""The contact solver: patch tests, Hertz 2D, the Jacobian, bad input, output, MPI."""
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+from dolfinx import fem, mesh
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
+from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
+
+DEMOS = Path(__file__).resolve().parent.parent / "demos"
+LOCAL_KINDS = ["LmLS", "LmLS*", "LcLS*", "LcLS"]
+
+
+def load(name):
+    spec = importlib.util.spec_from_file_location(name, DEMOS / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def block_on_plane(comm=MPI.COMM_WORLD, n=(8, 4)):
+    """[0,1]x[0,0.5]; tags: 1 bottom (slave), 2 top (load), 3 left (u_x = 0)."""
+    domain = mesh.create_rectangle(comm, [[0, 0], [1, 0.5]], list(n))
+    marks = [(1, lambda x: np.isclose(x[1], 0)), (2, lambda x: np.isclose(x[1], 0.5)),
+             (3, lambda x: np.isclose(x[0], 0) & (x[1] > 1e-9) & (x[1] < 0.5 - 1e-9))]
+    facets, values = [], []
+    for tag, where in marks:
+        f = mesh.locate_entities_boundary(domain, 1, where)
+        facets.append(f)
+        values.append(np.full(len(f), tag, dtype=np.int32))
+    facets, values = np.concatenate(facets), np.concatenate(values)
+    order = np.argsort(facets)
+    tags = mesh.meshtags(domain, 1, facets[order].astype(np.int32), values[order])
+    return fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags
+
+
+@pytest.mark.parametrize("kind", LOCAL_KINDS)
+def test_block_on_rigid_plane_carries_the_applied_pressure(kind):
+    V, tags = block_on_plane()
+    problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
+                             kind=kind, penalty=1e4, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    result = problem.solve(load_steps=2)
+    p = problem.nodal_pressures()
+    on = problem.gap_model.basis.lumped_weights > 0
+    assert np.max(np.abs(p[on] / 0.01 - 1), initial=0) < 1e-10
+    assert result.newton_iterations <= 4
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_patch_test_passes_with_the_consistent_scaling(dim):
+    demo = load("patch_test")
+    args = demo.parse_args(["--dim", str(dim)] + (["--fine", "0.25", "--coarse", "0.35"]
+                                                   if dim == 3 else []))
+    for orientation in ("finer-slave", "finer-master"):
+        for kind in LOCAL_KINDS:
+            r = demo.run(args, orientation, kind, "consistent")
+            assert r["max_relative_deviation"] < 1e-8, r
+
+
+def test_seed_scaling_fails_the_patch_test():
+    demo = load("patch_test")
+    args = demo.parse_args(["--dim", "2"])
+    seed = demo.run(args, "finer-slave", "LmLS*", "seed")["max_relative_deviation"]
+    assert seed > 1e-3  # node-wise penalty ε W_A on a non-uniform mesh
+
+
+@pytest.mark.parametrize("starred, unstarred", [("LcLS*", "LcLS"), ("LmLS*", "LmLS")])
+def test_starred_and_unstarred_kinds_give_the_same_problem_when_consistent(starred, unstarred):
+    V, tags = block_on_plane(n=(10, 4))
+    solutions = []
+    for kind in (starred, unstarred):
+        problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -3.0], 3.0), E=1.0,
+                                 nu=0.3, kind=kind, penalty=100.0, fixed={3: {0: 0.0}},
+                                 tractions={2: [0.0, -0.01]})
+        problem.solve(load_steps=2)
+        solutions.append(problem.u.x.array.copy())
+    assert np.max(np.abs(solutions[0] - solutions[1])) <= 1e-12 * np.max(np.abs(solutions[0]))
+
+
+def test_hertz2d_coarse_is_within_one_percent():
+    figures = load("hertz2d").main(["--refine", "0.6"])
+    assert abs(figures["p0_error"]) < 0.01
+    assert abs(figures["a_error"]) < 0.01
+    assert abs(figures["force_error"]) < 1e-8
+    assert figures["l2_error"] < 0.02
+
+
+@pytest.mark.slow
+def test_hertz2d_pressure_error_falls_with_refinement():
+    demo = load("hertz2d")
+    errors = [demo.main(["--refine", str(r)])["l2_error"] for r in (0.5, 1.0)]
+    assert errors[1] < 0.7 * errors[0], errors
+
+
+def test_hertz2d_same_figures_on_one_and_all_ranks():
+    demo = load("hertz2d")
+    args = demo.parse_args(["--refine", "0.4", "--load-steps", "2"])
+    results = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        ref = demo.hertz(args)
+        domain, tags, h = demo.build_mesh(args, ref["a"], comm)
+        V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+        problem = ContactProblem(V, tags, demo.SLAVE, obstacle=RigidPlane([0, 0], [0, 1]),
+                                 E=1.0, nu=0.3, kind="LcLS*", penalty=1e3 / h,
+                                 fixed={demo.SYMMETRY: {0: 0.0}},
+                                 tractions={demo.LOAD: [0.0, -0.005]})
+        problem.solve(load_steps=2)
+        results.append(demo.contact_results(problem, ref))
+    for key in ("p0", "a", "l2_error", "contact_force"):
+        assert results[0][key] == pytest.approx(results[1][key], rel=1e-8), key
+
+
+@pytest.mark.parametrize("kind", ["LmLS", "LcLS*"])
+@pytest.mark.parametrize("obstacle", ["plane", "sphere"])
+def test_jacobian_matches_finite_differences(kind, obstacle):
+    V, tags = block_on_plane(n=(6, 3))
+    ob = (RigidPlane([0, 0.01], [0, 1]) if obstacle == "plane"
+          else RigidSphere([0.5, -2.0], 2.01))
+    problem = ContactProblem(V, tags, 1, obstacle=ob, E=1.0, nu=0.3, kind=kind, penalty=50.0,
+                             fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]})
+    problem._set_load(1.0)
+    problem.u.interpolate(lambda x: np.vstack([0.001 * x[1], -0.002 + 0.003 * x[0] ** 2]))
+    x0 = problem.u.vector.copy()
+    J = problem._total_matrix()
+    b0 = problem.b.duplicate()
+    problem._residual(None, x0, b0)
+    problem._jacobian(None, x0, J, J)
+    assert problem.mesh.comm.allreduce(int(np.sum(problem.nodal_gaps() > 0))) > 0
+    dx = x0.duplicate()
+    dx.array[:] = np.random.default_rng(1).normal(size=dx.array.shape) * 1e-3
+    fem.petsc.set_bc(dx, problem.bcs, scale=0.0)
+    Jdx = b0.duplicate()
+    J.mult(dx, Jdx)
+    h = 1e-4
+    x1 = x0.copy()
+    x1.axpy(h, dx)
+    b1 = b0.duplicate()
+    problem._residual(None, x1, b1)
+    fd = b1.copy()
+    fd.axpy(-1.0, b0)
+    fd.scale(1 / h)
+    fd.axpy(-1.0, Jdx)
+    assert fd.norm() < 1e-4 * Jdx.norm()   # a kink crossing would break this: h is tiny
+
+
+def test_divergence_error_carries_the_residual_history():
+    V, tags = block_on_plane()
+    problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
+                             kind="LcLS*", penalty=1e4, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    opts = PETSc.Options()
+    opts["starved_snes_max_it"] = 1
+    opts["starved_snes_rtol"] = 1e-30
+    opts["starved_snes_atol"] = 1e-30
+    try:
+        with pytest.raises(ContactDivergenceError) as err:
+            problem.solve(load_steps=1, max_cuts=2, prefix="starved_")
+    finally:
+        for key in ("snes_max_it", "snes_rtol", "snes_atol"):
+            opts.delValue("starved_" + key)
+    assert len(err.value.history) == 3
+    assert "residuals" in str(err.value) and err.value.history[0][2]
+
+
+def test_converged_steps_are_written_to_xdmf(tmp_path_factory):
+    # one folder for all ranks: the XDMF file is written collectively
+    comm = MPI.COMM_WORLD
+    path = comm.bcast(str(tmp_path_factory.mktemp("xdmf")) if comm.rank == 0 else None)
+    V, tags = block_on_plane()
+    problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
+                             kind="LcLS*", penalty=1e4, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    problem.solve(load_steps=3, output=Path(path) / "block.xdmf")
+    if MPI.COMM_WORLD.rank == 0:
+        text = (Path(path) / "block.xdmf").read_text()
+        assert text.count('Name="displacement"') >= 3 and "contact_pressure" in text
+        assert (Path(path) / "block.h5").stat().st_size > 0
+
+
+def test_bad_input_is_reported():
+    V, tags = block_on_plane()
+    common = dict(E=1.0, nu=0.3, fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]})
+    plane = RigidPlane([0, 0], [0, 1])
+    with pytest.raises(ValueError, match="penalty must be positive"):
+        ContactProblem(V, tags, 1, obstacle=plane, penalty=-1.0, **common)
+    with pytest.raises(ValueError, match="unknown mortar basis kind 'Dual'"):
+        ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, kind="Dual", **common)
+    with pytest.raises(ValueError, match="facet tag 9 marks no facets"):
+        ContactProblem(V, tags, 9, obstacle=plane, penalty=1.0, **common)
+    with pytest.raises(ValueError, match="overlap"):
+        ContactProblem(V, tags, 1, master_tag=1, penalty=1.0, **common)
+    with pytest.raises(ValueError, match="exactly one"):
+        ContactProblem(V, tags, 1, penalty=1.0, **common)
+    with pytest.raises(ValueError, match="3D obstacle in a 2D mesh"):
+        ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0, 0], [0, 0, 1]), penalty=1.0,
+                       **common)
+    with pytest.raises(NotImplementedError, match="augmented form"):
+        ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, kind="GLS", **common)
+    with pytest.raises(ValueError, match="unknown scaling"):
+        ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, scaling="paper", **common)
+    problem = ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, **common)
+    problem.u.x.array[0] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        problem.solve()
