@@ -20,7 +20,7 @@ DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 
 help:
 	@echo "make setup  - install missing Debian packages, build the kernels, make dolfinx_mortar importable"
-	@echo "make demo   - setup, then the main demo (figures 1 and 2) into results/"
+	@echo "make demo   - setup, then the main demo (Hertz 2D, figures 1 and 2) into results/"
 	@echo "make test   - setup, then C++ tests (ctest), pytest, and pytest under mpirun -n 2"
 	@echo "make bench  - setup, then the benchmarks in benchmarks/"
 	@echo "make stress - setup, then 1e6 generated slave-master pairs through 3D segmentation"
@@ -53,6 +53,7 @@ install:
 	cd / && $(PYTHON) -c "import dolfinx_mortar, sys; print('dolfinx_mortar importable from', dolfinx_mortar.__file__)"
 
 demo: setup
+	$(PYTHON) demos/hertz2d.py --json results/hertz2d.json --output results/hertz2d.xdmf
 	$(PYTHON) demos/fig1_bases.py --json results/fig1_bases.json
 	$(PYTHON) demos/fig2_sphere_nurbs.py --json results/fig2_pressures.json
 
