@@ -1,0 +1,239 @@
+"""Hertz 3D: an elastic sphere on a rigid plane, or two elastic bodies from a gmsh file.
+
+Built-in scene: a quarter of the lower half of a sphere (radius R, centre
+(0, 0, R); symmetry u_x = 0 at x = 0 and u_y = 0 at y = 0) carries the load F
+as a uniform traction F/(πR²) on its flat top z = R and touches the analytic
+rigid plane z = 0 (not meshed). The gmsh mesh is graded to size a/(8·refine)
+at the contact, a the Hertz radius.
+
+``--mesh FILE.msh`` reads a gmsh mesh instead, with the physical groups
+(volumes) ``body_slave``, ``body_master`` and (surfaces) ``slave``,
+``master``, ``fixed`` (u = 0), ``load``, ``sym_x`` (u_x = 0), ``sym_y``
+(u_y = 0). With a ``master`` group the two bodies are in contact (same
+material); without it the slave touches the rigid plane z = 0.
+``--load-displacement δ`` prescribes u = (0, 0, −δ) on ``load``; otherwise
+``--force F`` is applied as a uniform traction over ``load``.
+
+Hertz: E* = E/(1−ν²) (rigid plane) or E/(2(1−ν²)) (two equal bodies),
+a = (3FR/(4E*))^⅓, p0 = 3F/(2πa²). With ``--load-displacement`` the force is
+the computed contact force.
+
+    /usr/bin/python3 demos/hertz3d.py --json results/hertz3d.json
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from typing import Optional, Sequence
+
+import numpy as np
+from mpi4py import MPI
+
+from dolfinx_mortar.output import write_json
+
+NAMES = ("slave", "master", "fixed", "load", "sym_x", "sym_y")
+SLAVE, MASTER, FIXED, LOAD, SYM_X, SYM_Y = range(1, 7)
+
+
+def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--radius", type=float, default=1.0, help="sphere radius R (1)")
+    parser.add_argument("--E", type=float, default=1.0, help="Young's modulus (1)")
+    parser.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
+    parser.add_argument("--force", type=float, default=0.0015,
+                        help="total force F on the whole sphere (0.0015: a ≈ 0.1 R)")
+    parser.add_argument("--load-displacement", type=float, default=None,
+                        help="prescribe u_z = −δ on 'load' instead of a force (mesh files)")
+    parser.add_argument("--refine", type=float, default=1.0,
+                        help="mesh density factor: contact size a/(8·refine) (1)")
+    parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
+    parser.add_argument("--penalty", type=float, default=1e3,
+                        help="penalty ε as a multiple of E/h_contact (1e3)")
+    parser.add_argument("--mesh", default=None, help="gmsh .msh file with the named groups")
+    parser.add_argument("--h-contact", type=float, default=None,
+                        help="contact element size of --mesh (for the penalty; default: "
+                             "the smallest slave facet)")
+    parser.add_argument("--load-steps", type=int, default=3, help="load steps (3)")
+    parser.add_argument("--output", default=None, help="XDMF file for the steps")
+    parser.add_argument("--json", default=None, help="write the key figures as JSON here")
+    return parser.parse_args(argv)
+
+
+def hertz(E_star: float, R: float, F: float) -> dict:
+    a = (3 * F * R / (4 * E_star)) ** (1 / 3)
+    return {"a": a, "p0": 3 * F / (2 * np.pi * a ** 2)}
+
+
+def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
+    """The built-in sphere octant, tagged with the names of a mesh file; optionally
+    also written to ``path`` (.msh) so that other codes can solve the same mesh."""
+    import gmsh
+    from dolfinx.io import gmshio
+    R = args.radius
+    h_contact = a / (8 * args.refine)
+    gmsh.initialize(["", "-v", "0"])
+    try:
+        if comm.rank == 0:
+            occ = gmsh.model.occ
+            sphere = occ.addSphere(0, 0, R, R)
+            box = occ.addBox(0, 0, 0, R, R, R)
+            body, _ = occ.intersect([(3, sphere)], [(3, box)])
+            occ.synchronize()
+            groups: dict = {SLAVE: [], LOAD: [], SYM_X: [], SYM_Y: []}
+            for _, s in gmsh.model.getBoundary(body, oriented=False):
+                x, y, z = occ.getCenterOfMass(2, s)
+                if abs(x) < 1e-6 * R:
+                    groups[SYM_X].append(s)
+                elif abs(y) < 1e-6 * R:
+                    groups[SYM_Y].append(s)
+                elif abs(z - R) < 1e-6 * R:
+                    groups[LOAD].append(s)
+                else:
+                    groups[SLAVE].append(s)
+            for tag, surfaces in groups.items():
+                gmsh.model.addPhysicalGroup(2, surfaces, tag)
+                gmsh.model.setPhysicalName(2, tag, NAMES[tag - 1])
+            gmsh.model.addPhysicalGroup(3, [body[0][1]], 1)
+            gmsh.model.setPhysicalName(3, 1, "body_slave")
+            point = occ.addPoint(0, 0, 0)
+            occ.synchronize()
+            field = gmsh.model.mesh.field
+            field.add("Distance", 1)
+            field.setNumbers(1, "PointsList", [point])
+            field.add("Threshold", 2)
+            field.setNumber(2, "InField", 1)
+            field.setNumber(2, "SizeMin", h_contact)
+            field.setNumber(2, "SizeMax", R / 5)
+            field.setNumber(2, "DistMin", 1.3 * a)
+            field.setNumber(2, "DistMax", 1.3 * a + 12 * (R / 5))
+            field.setAsBackgroundMesh(2)
+            for option in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints",
+                           "MeshSizeFromCurvature"):
+                gmsh.option.setNumber(f"Mesh.{option}", 0)
+            gmsh.model.mesh.generate(3)
+            if path is not None:
+                gmsh.write(path)
+        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
+    finally:
+        gmsh.finalize()
+    return domain, facet_tags, h_contact
+
+
+def read_mesh(path: str, comm: MPI.Comm):
+    """A gmsh file and the tag of each named physical surface group present."""
+    import gmsh
+    from dolfinx.io import gmshio
+    tags = None
+    if comm.rank == 0:
+        gmsh.initialize(["", "-v", "0"])
+        try:
+            gmsh.open(path)
+            tags = {gmsh.model.getPhysicalName(2, t): t
+                    for _, t in gmsh.model.getPhysicalGroups(2)}
+        finally:
+            gmsh.finalize()
+    tags = comm.bcast(tags)
+    unknown = set(tags) - set(NAMES) - {""}
+    if unknown or "slave" not in tags:
+        raise ValueError(f"{path}: physical surfaces must be named among {NAMES} and include "
+                         f"'slave'; found {sorted(tags)}")
+    domain, _, facet_tags = gmshio.read_from_msh(path, comm, 0, gdim=3)
+    return domain, facet_tags, tags
+
+
+def contact_results(problem, E_star: float, R: float, force: float) -> dict:
+    comm = problem.mesh.comm
+    slave = problem.slave
+    n = slave.layout.num_owned
+    p = problem.nodal_pressures()
+    on = np.zeros(slave.layout.size_local, dtype=bool)
+    on[slave.cells] = True
+    mine = on[:n] & (p[:n] > 0)
+    r = np.linalg.norm(slave.x[:n][mine][:, :2], axis=1)
+    rs = np.concatenate(comm.allgather(r))
+    ps = np.concatenate(comm.allgather(p[:n][mine]))
+    inner = rs < 0.9 * np.max(rs)
+    c1, c0 = np.polyfit(rs[inner] ** 2, ps[inner] ** 2, 1)  # p² linear in r²
+    a_fit = float(np.sqrt(-c0 / c1)) if c1 < 0 < c0 else float("nan")
+    ref = hertz(E_star, R, force)
+    p0 = float(np.max(ps))
+    return {"p0": p0, "a": a_fit, "hertz_p0": ref["p0"], "hertz_a": ref["a"],
+            "p0_error": p0 / ref["p0"] - 1, "a_error": a_fit / ref["a"] - 1,
+            "active_nodes": int(len(rs))}
+
+
+def main(argv: Optional[Sequence[str]] = None) -> dict:
+    args = parse_args(argv)
+    from dolfinx import fem
+    import ufl
+    from dolfinx_mortar.obstacles import RigidPlane
+    from dolfinx_mortar.problem import ContactProblem
+    comm = MPI.COMM_WORLD
+    clock = time.perf_counter()
+    E_star = args.E / (1 - args.nu ** 2)
+    if args.mesh is None:
+        domain, facet_tags, h_contact = build_octant(args, hertz(E_star, args.radius,
+                                                                 args.force)["a"], comm)
+        names = {name: i + 1 for i, name in enumerate(NAMES) if i + 1 in (SLAVE, LOAD, SYM_X,
+                                                                           SYM_Y)}
+    else:
+        domain, facet_tags, names = read_mesh(args.mesh, comm)
+        h_contact = args.h_contact
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    if h_contact is None:
+        from dolfinx_mortar.facet_surface import facet_surface
+        s = facet_surface(V, facet_tags, names["slave"])
+        local = np.min(np.ptp(s.x[s.cells], axis=1).max(axis=1), initial=np.inf)
+        h_contact = comm.allreduce(float(local), op=MPI.MIN)
+    fixed = {}
+    for name, comps in (("sym_x", {0: 0.0}), ("sym_y", {1: 0.0}),
+                        ("fixed", {0: 0.0, 1: 0.0, 2: 0.0})):
+        if name in names:
+            fixed[names[name]] = comps
+    tractions = {}
+    quarter = 4.0 if "sym_x" in names and "sym_y" in names else 1.0
+    if args.load_displacement is not None:
+        fixed[names["load"]] = {0: 0.0, 1: 0.0, 2: -args.load_displacement}
+    else:
+        ds = ufl.Measure("ds", domain=domain, subdomain_data=facet_tags)
+        area = comm.allreduce(fem.assemble_scalar(fem.form(
+            fem.Constant(domain, 1.0) * ds(names["load"]))))
+        tractions[names["load"]] = [0.0, 0.0, -args.force / quarter / area]
+    kwargs = ({"master_tag": names["master"]} if "master" in names
+              else {"obstacle": RigidPlane([0.0, 0.0, 0.0], [0.0, 0.0, 1.0])})
+    if "master" in names:
+        E_star /= 2
+    problem = ContactProblem(V, facet_tags, names["slave"], E=args.E, nu=args.nu,
+                             kind=args.kind, penalty=args.penalty * args.E / h_contact,
+                             fixed=fixed, tractions=tractions, **kwargs)
+    result = problem.solve(load_steps=args.load_steps, output=args.output,
+                           progress=comm.rank == 0)
+    wall = time.perf_counter() - clock
+    n = problem.slave.layout.num_owned
+    contact_force = quarter * comm.allreduce(float(np.sum(
+        problem.gap_model.weights[:n] * np.maximum(problem.nodal_gaps()[:n], 0.0))))
+    force = args.force if args.load_displacement is None else contact_force
+    figures = contact_results(problem, E_star, args.radius, force)
+    dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+    figures.update({"dofs": int(dofs), "newton_iterations": result.newton_iterations,
+                    "load_steps": len(result.steps), "wall_time": wall,
+                    "h_contact": h_contact, "contact_force": contact_force, "force": force,
+                    "kind": args.kind, "refine": args.refine, "ranks": comm.size,
+                    "mesh": args.mesh})
+    if comm.rank == 0:
+        print(f"Hertz 3D ({'mesh ' + args.mesh if args.mesh else 'sphere on a rigid plane'}, "
+              f"{args.kind}, {dofs} dofs, {comm.size} rank(s))")
+        print(f"  peak pressure p0 = {figures['p0']:.6g}  (Hertz {figures['hertz_p0']:.6g}, "
+              f"error {100 * figures['p0_error']:+.2f}%)")
+        print(f"  contact radius a = {figures['a']:.6g}  (Hertz {figures['hertz_a']:.6g}, "
+              f"error {100 * figures['a_error']:+.2f}%)")
+        print(f"  contact force {contact_force:.6g} (applied {force:.6g}); h at contact "
+              f"{h_contact:.3g}; Newton iterations {result.newton_iterations}; "
+              f"wall time {wall:.1f} s")
+    if args.json and comm.rank == 0:
+        write_json(args.json, figures)
+    return figures
+
+
+if __name__ == "__main__":
+    main()
