@@ -121,23 +121,13 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
 
 def read_mesh(path: str, comm: MPI.Comm):
     """A gmsh file and the tag of each named physical surface group present."""
-    import gmsh
-    from dolfinx.io import gmshio
-    tags = None
-    if comm.rank == 0:
-        gmsh.initialize(["", "-v", "0"])
-        try:
-            gmsh.open(path)
-            tags = {gmsh.model.getPhysicalName(2, t): t
-                    for _, t in gmsh.model.getPhysicalGroups(2)}
-        finally:
-            gmsh.finalize()
-    tags = comm.bcast(tags)
+    from dolfinx_mortar.gmsh_io import read_gmsh
+    domain, _, facet_tags, names = read_gmsh(path, comm, gdim=3)
+    tags = names.get(2, {})
     unknown = set(tags) - set(NAMES) - {""}
     if unknown or "slave" not in tags:
         raise ValueError(f"{path}: physical surfaces must be named among {NAMES} and include "
                          f"'slave'; found {sorted(tags)}")
-    domain, _, facet_tags = gmshio.read_from_msh(path, comm, 0, gdim=3)
     return domain, facet_tags, tags
 
 
@@ -162,13 +152,12 @@ def contact_results(problem, E_star: float, R: float, force: float) -> dict:
             "active_nodes": int(len(rs))}
 
 
-def main(argv: Optional[Sequence[str]] = None) -> dict:
-    args = parse_args(argv)
+def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
+    """Solve the scene on ``comm``; the key figures on every rank."""
     from dolfinx import fem
     import ufl
     from dolfinx_mortar.obstacles import RigidPlane
     from dolfinx_mortar.problem import ContactProblem
-    comm = MPI.COMM_WORLD
     clock = time.perf_counter()
     E_star = args.E / (1 - args.nu ** 2)
     if args.mesh is None:
@@ -220,6 +209,15 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
                     "h_contact": h_contact, "contact_force": contact_force, "force": force,
                     "kind": args.kind, "refine": args.refine, "ranks": comm.size,
                     "mesh": args.mesh})
+    return figures
+
+
+def main(argv: Optional[Sequence[str]] = None) -> dict:
+    args = parse_args(argv)
+    comm = MPI.COMM_WORLD
+    figures = run(args, comm)
+    contact_force, force, h_contact = figures["contact_force"], figures["force"], figures["h_contact"]
+    dofs, wall = figures["dofs"], figures["wall_time"]
     if comm.rank == 0:
         print(f"Hertz 3D ({'mesh ' + args.mesh if args.mesh else 'sphere on a rigid plane'}, "
               f"{args.kind}, {dofs} dofs, {comm.size} rank(s))")
@@ -228,7 +226,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
         print(f"  contact radius a = {figures['a']:.6g}  (Hertz {figures['hertz_a']:.6g}, "
               f"error {100 * figures['a_error']:+.2f}%)")
         print(f"  contact force {contact_force:.6g} (applied {force:.6g}); h at contact "
-              f"{h_contact:.3g}; Newton iterations {result.newton_iterations}; "
+              f"{h_contact:.3g}; Newton iterations {figures['newton_iterations']}; "
               f"wall time {wall:.1f} s")
     if args.json and comm.rank == 0:
         write_json(args.json, figures)

@@ -209,3 +209,30 @@ def test_bad_input_is_reported():
     problem.u.x.array[0] = np.nan
     with pytest.raises(ValueError, match="NaN"):
         problem.solve()
+
+
+def test_hertz3d_coarse_sphere_on_rigid_plane():
+    demo = load("hertz3d")
+    figures = demo.run(demo.parse_args(["--refine", "0.5", "--load-steps", "2"]), MPI.COMM_WORLD)
+    assert abs(figures["p0_error"]) < 0.10 and abs(figures["a_error"]) < 0.06, figures
+    assert figures["contact_force"] == pytest.approx(figures["force"], rel=1e-8)
+
+
+def test_hertz3d_mesh_file_and_ranks_reproduce_the_builtin_scene(tmp_path_factory):
+    demo = load("hertz3d")
+    comm = MPI.COMM_WORLD
+    path = comm.bcast(str(tmp_path_factory.mktemp("msh") / "octant.msh")
+                      if comm.rank == 0 else None)
+    args = demo.parse_args(["--refine", "0.4", "--load-steps", "2"])
+    E_star = args.E / (1 - args.nu ** 2)
+    a = demo.hertz(E_star, args.radius, args.force)["a"]
+    if comm.rank == 0:  # write the built-in mesh, as another code would receive it
+        demo.build_octant(args, a, MPI.COMM_SELF, path)
+    comm.barrier()
+    builtin = demo.run(args, comm)
+    serial = demo.run(args, MPI.COMM_SELF)
+    from_file = demo.run(demo.parse_args(["--mesh", path, "--load-steps", "2",
+                                          "--h-contact", str(builtin["h_contact"])]), comm)
+    for key in ("p0", "a", "contact_force"):
+        assert from_file[key] == pytest.approx(builtin[key], rel=1e-8), key
+        assert serial[key] == pytest.approx(builtin[key], rel=1e-8), key
