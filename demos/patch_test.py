@@ -20,7 +20,7 @@ from mpi4py import MPI
 from dolfinx_mortar.output import write_json
 
 LOWER_TOP, UPPER_BOTTOM, TOP, BOTTOM, SYM_X, SYM_Y = 1, 2, 3, 4, 5, 6
-LOCAL_KINDS = ("LmLS", "LmLS*", "LcLS*", "LcLS")
+ALL_KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
@@ -31,7 +31,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--coarse", type=float, default=0.14, help="coarser size (0.14)")
     parser.add_argument("--orientation", default="both",
                         choices=("finer-slave", "finer-master", "both"))
-    parser.add_argument("--kinds", nargs="+", default=list(LOCAL_KINDS))
+    parser.add_argument("--kinds", nargs="+", default=list(ALL_KINDS))
     parser.add_argument("--scalings", nargs="+", default=["consistent", "seed"])
     parser.add_argument("--pressure", type=float, default=0.01, help="applied pressure (0.01)")
     parser.add_argument("--E", type=float, default=1.0)

@@ -40,15 +40,16 @@ SCALINGS = ("consistent", "seed")
 
 
 def gap_kind(kind: KindLike, scaling: str) -> BasisKind:
-    """The basis whose integrals define the nodal gaps for a scaling."""
+    """The basis whose integrals define the nodal gaps for a scaling.
+
+    For GLS/GLS* this is the standard basis N: their gaps are ``L⁻¹ ∫N d``
+    (:class:`GlobalGap`).
+    """
     if scaling not in SCALINGS:
         raise ValueError(f"unknown scaling '{scaling}'; expected one of {SCALINGS}")
     kind = parse_kind(kind)
     if is_global(kind):
-        raise NotImplementedError(
-            f"contact with the global kind {kind_name(kind)} needs the augmented form "
-            "L y = ĝ(u) of DESIGN.md §3, which is not implemented yet; use a local kind "
-            "(LmLS, LmLS*, LcLS*, LcLS)")
+        return BasisKind.LmLS_star
     return unstarred_partner(kind) if scaling == "consistent" else kind
 
 
@@ -194,3 +195,37 @@ class MortarGap(_GapBase):
         Gu = self.G.createVecLeft()
         self.G.mult(u, Gu)
         return self.gaps0 + self.slave.layout.to_local(Gu)
+
+
+class GlobalGap:
+    """Nodal gaps of GLS and GLS*: ``d̄ = L⁻¹ ĝ(u)`` with ``ĝ_B = ∫ N_B d``.
+
+    ``M_A`` has global support, so ``G = L⁻¹ Ĝ`` is dense; only the sparse
+    ``Ĝ = ∂ĝ/∂u`` and ``L`` are assembled, and the Newton step solves the
+    augmented system of DESIGN.md §3 (see :class:`AugmentedNewtonStep`).
+    ``inner`` computes ``ĝ`` and ``Ĝ`` (a standard-basis gap model).
+    """
+
+    def __init__(self, inner, kind: KindLike, penalty: float, scaling: str):
+        self.inner = inner
+        self.kind = parse_kind(kind)
+        self.scaling = scaling
+        self.slave = inner.slave
+        self.basis = MortarBasis(BasisKind.GLS, self.slave)
+        W = self.basis.lumped_weights
+        # Π_c = Σ (ω_A/2)⟨d̄_A⟩² in terms of the GLS gap d̄ (∫M_A = 1):
+        # consistent ω = εW; seed GLS ω = ε; seed GLS* (d_A = W_A d̄_A) ω = εW².
+        if scaling == "consistent":
+            self.weights = penalty * W
+        elif self.kind == BasisKind.GLS:
+            self.weights = penalty * np.ones_like(W)
+        else:
+            self.weights = penalty * W ** 2
+        self.dofs = inner.dofs
+        self.mass = self.basis._solver
+
+    def nodal_pressures(self, gaps: FloatArray) -> FloatArray:
+        """``p_A = ω_A⟨d̄_A⟩/W_A`` (coefficients of the traction in the PU basis GLS*)."""
+        W = self.basis.lumped_weights
+        return np.divide(self.weights * np.maximum(gaps, 0.0), W, out=np.zeros_like(W),
+                         where=W > 0)

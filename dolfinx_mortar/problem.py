@@ -20,9 +20,9 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact_terms import MortarGap, ObstacleGap, gap_kind
+from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_kind
 from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
-from dolfinx_mortar.kinds import KindLike, kind_name, parse_kind
+from dolfinx_mortar.kinds import KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.mortar import MortarCoupling
 from dolfinx_mortar.obstacles import RigidObstacle
 
@@ -35,8 +35,9 @@ CONFIGURATIONS = ("initial", "previous", "current")
 DEFAULT_OPTIONS = {
     "snes_type": "newtonls",
     "snes_linesearch_type": "basic",
-    "snes_rtol": 1e-9,
-    "snes_atol": 1e-10,
+    "snes_rtol": 1e-11,
+    # absolute residuals depend on the units: rely on the relative test
+    "snes_atol": 1e-15,
     "snes_stol": 0.0,
     "snes_max_it": 40,
     # the first step of a contact problem often overshoots into the obstacle
@@ -108,7 +109,8 @@ class ContactProblem:
     E, nu
         Young's modulus and Poisson's ratio.
     kind
-        Mortar basis kind (local kinds: LmLS, LmLS*, LcLS*, LcLS).
+        Mortar basis kind, any of the six (GLS/GLS* through the augmented
+        Newton step, :class:`AugmentedNewtonStep`).
     penalty
         ε, pressure per length (consistent scaling).
     scaling
@@ -228,11 +230,13 @@ class ContactProblem:
         """(Re)build the gap model; for an elastic master in the configuration u."""
         clock = time.perf_counter()
         if self.obstacle is not None:
-            self.gap_model = ObstacleGap(self.slave, self.obstacle, self.kind, self.penalty,
-                                         self.scaling)
+            model = ObstacleGap(self.slave, self.obstacle, self.kind, self.penalty,
+                                self.scaling)
         else:
             coupling = MortarCoupling(self.slave, self.master, u_nodes, u_nodes)
-            self.gap_model = MortarGap(coupling, self.kind, self.penalty, self.scaling)
+            model = MortarGap(coupling, self.kind, self.penalty, self.scaling)
+        self.gap_model = (GlobalGap(model, self.kind, self.penalty, self.scaling)
+                          if is_global(self.kind) else model)
         self._A_total: Optional[PETSc.Mat] = None
         self._bc_mask: Optional[PETSc.Vec] = None
         self.timings_segmentation = time.perf_counter() - clock
@@ -246,30 +250,40 @@ class ContactProblem:
             self._bc_mask = m
         return self._bc_mask
 
-    def _contact(self) -> tuple[FloatArray, PETSc.Mat, Optional[PETSc.Mat]]:
-        """Nodal gaps, masked G and masked curvature matrix at the current u."""
-        if isinstance(self.gap_model, ObstacleGap):
-            u_nodes = nodal_displacement(self.slave, self.u)
-            gaps, G, x = self.gap_model.evaluate(u_nodes)
-            coefficient = self.gap_model.weights * np.maximum(gaps, 0.0)
-            blocks = self.gap_model.curvature_blocks(coefficient, x)
-            K_curv = None
+    def _contact(self) -> tuple[FloatArray, PETSc.Mat, FloatArray, Optional[PETSc.Mat]]:
+        """Contact state at the current u.
+
+        Returns the nodal gaps d̄, the masked derivative G of the gaps the
+        model assembles (Ĝ for GLS kinds), the nodal vector f with
+        ``R_c = Gᵀ f``, and the masked curvature matrix (or None).
+        """
+        model = self.gap_model
+        inner = model.inner if isinstance(model, GlobalGap) else model
+        x = None
+        if isinstance(inner, ObstacleGap):
+            gaps, G, x = inner.evaluate(nodal_displacement(self.slave, self.u))
+        else:
+            G = inner.G.copy()
+            gaps = inner.evaluate(self.u.vector)
+        if isinstance(model, GlobalGap):
+            gaps = model.mass.solve(gaps)                                  # d̄ = L⁻¹ ĝ
+            force = model.mass.solve(model.weights * np.maximum(gaps, 0.0))  # z = L⁻¹ ω⟨d̄⟩
+        else:
+            force = model.weights * np.maximum(gaps, 0.0)
+        G.diagonalScale(None, self._mask())
+        K_curv = None
+        if x is not None:
+            blocks = inner.curvature_blocks(force, x)
             if blocks is not None:
                 from dolfinx_mortar.layout import assemble_blocks
-                gm = self.gap_model
                 nc, nd = self.slave.cells.shape
                 width = nd * self.slave.gdim
-                dofs = gm._node_dofs(self.slave.cells).reshape(nc, width)
+                dofs = inner._node_dofs(self.slave.cells).reshape(nc, width)
                 local = (self.slave.cells[..., None] * self.slave.gdim
                          + np.arange(self.slave.gdim)).reshape(nc, width)
-                K_curv = assemble_blocks(gm.dofs, local, gm.dofs, dofs, blocks)
+                K_curv = assemble_blocks(inner.dofs, local, inner.dofs, dofs, blocks)
                 K_curv.diagonalScale(self._mask(), self._mask())
-        else:
-            G = self.gap_model.G.copy()
-            gaps = self.gap_model.evaluate(self.u.vector)
-            K_curv = None
-        G.diagonalScale(None, self._mask())
-        return gaps, G, K_curv
+        return gaps, G, force, K_curv
 
     # -- SNES callbacks --------------------------------------------------------------
     def _residual(self, snes, x: PETSc.Vec, b: PETSc.Vec) -> None:
@@ -283,11 +297,10 @@ class ContactProblem:
         b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         self._add("bulk_residual", clock)
         clock = time.perf_counter()
-        gaps, G, K_curv = self._contact()
-        self._state = (gaps, G, K_curv)
-        force = self.slave.layout.vector(self.gap_model.weights * np.maximum(gaps, 0.0))
+        gaps, G, force, K_curv = self._contact()
+        self._state = (gaps, G, force, K_curv)
         Rc = G.createVecRight()
-        G.multTranspose(force, Rc)
+        G.multTranspose(self.slave.layout.vector(force), Rc)
         b.axpy(1.0, Rc)
         self._add("contact_residual", clock)
         fem_petsc.set_bc(b, self.bcs, x, -1.0)
@@ -299,10 +312,17 @@ class ContactProblem:
         self.A_bulk.assemble()
         self._add("bulk_jacobian", clock)
         clock = time.perf_counter()
-        gaps, G, K_curv = self._state
-        active = self.slave.layout.vector(self.gap_model.weights * self._active(gaps))
+        gaps, G, force, K_curv = self._state
+        weights = self.gap_model.weights * self._active(gaps)
+        if isinstance(self.gap_model, GlobalGap):
+            K = self.A_bulk.copy()
+            if K_curv is not None:
+                K.axpy(1.0, K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            self._augmented.update(K, G, weights, self.gap_model.mass.matrix)
+            self._add("contact_jacobian", clock)
+            return
         SG = G.copy()
-        SG.diagonalScale(active, None)
+        SG.diagonalScale(self.slave.layout.vector(weights), None)
         Kc = G.transposeMatMult(SG)
         J.zeroEntries()
         J.axpy(1.0, self.A_bulk, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
@@ -336,17 +356,23 @@ class ContactProblem:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
 
     def _total_matrix(self) -> PETSc.Mat:
-        """Bulk pattern ∪ contact pattern, built once per segmentation."""
+        """Bulk pattern ∪ contact pattern, built once per segmentation.
+
+        For GLS kinds the Newton step comes from the augmented system and this
+        matrix only carries the bulk pattern (SNES needs a matrix object).
+        """
         if self._A_total is None:
             self._residual(None, self.u.vector, self.b)
-            gaps, G, K_curv = self._state
+            gaps, G, force, K_curv = self._state
             A = self.A_bulk.duplicate(copy=False)
             fem_petsc.assemble_matrix(A, self.J_form, self.bcs)
             A.assemble()
-            Kc = G.transposeMatMult(G)
-            A.axpy(1.0, Kc, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            if K_curv is not None:
-                A.axpy(1.0, K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            if not isinstance(self.gap_model, GlobalGap):
+                Kc = G.transposeMatMult(G)
+                A.axpy(1.0, Kc, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+                if K_curv is not None:
+                    A.axpy(1.0, K_curv,
+                           structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             self._A_total = A
         return self._A_total
 
@@ -362,6 +388,14 @@ class ContactProblem:
         snes.setJacobian(self._jacobian, self._total_matrix())
         snes.setConvergenceHistory()
         snes.setFromOptions()
+        if isinstance(self.gap_model, GlobalGap):
+            # The Newton step is the exact solve of the augmented system; the
+            # SNES's own KSP only applies it.
+            self._augmented = AugmentedNewtonStep(self.mesh.comm, prefix + "augmented_")
+            ksp = snes.getKSP()
+            ksp.setType("preonly")
+            ksp.getPC().setType("python")
+            ksp.getPC().setPythonContext(self._augmented)
         return snes
 
     def _set_load(self, factor: float) -> None:
@@ -443,10 +477,7 @@ class ContactProblem:
     # -- results ---------------------------------------------------------------------
     def nodal_gaps(self) -> FloatArray:
         """``d̄_A`` at the local slave-layout nodes for the current u."""
-        if isinstance(self.gap_model, ObstacleGap):
-            gaps, _, _ = self.gap_model.evaluate(nodal_displacement(self.slave, self.u))
-            return gaps
-        return self.gap_model.evaluate(self.u.vector)
+        return self._contact()[0]
 
     def nodal_pressures(self) -> FloatArray:
         """Contact pressure ``p_A = ε⟨d̄_A⟩`` (consistent scaling) at local nodes."""
@@ -484,3 +515,59 @@ class ContactProblem:
             p1.interpolate(p)
             p = p1
         return u1, p
+
+
+class AugmentedNewtonStep:
+    """Exact Newton step for GLS/GLS* through the sparse augmented system.
+
+    With y = d̄ and z = L⁻¹ ω⟨y⟩ (DESIGN.md §3), the Newton matrix
+    ``K + Ĝᵀ L⁻¹ diag(ωH) L⁻¹ Ĝ`` is the Schur complement of
+
+        [ K    0     Ĝᵀ ] [Δu]   [r]
+        [ 0    ωH   −L  ] [Δy] = [0]
+        [ Ĝ   −L     0  ] [Δz]   [0]
+
+    which is sparse: it is assembled (MatNest → AIJ) and factorized (MUMPS by
+    default; options prefix ``dolfinx_mortar_augmented_``), and its Δu is the
+    step. No dense slave block is formed. Used as a PETSc python PC.
+    """
+
+    def __init__(self, comm: MPI.Comm, prefix: str):
+        self.comm = comm
+        self.prefix = prefix
+        self.ksp: Optional[PETSc.KSP] = None
+
+    def update(self, K: PETSc.Mat, G: PETSc.Mat, weights: FloatArray, L: PETSc.Mat) -> None:
+        layout_vec = L.createVecLeft()
+        layout_vec.array[:] = weights[: layout_vec.getLocalSize()]
+        S = PETSc.Mat().createAIJ(L.getSizes(), nnz=(1, 0), comm=L.comm)
+        S.setDiagonal(layout_vec)
+        S.assemble()
+        minus_L = L.copy()
+        minus_L.scale(-1.0)
+        GT = G.copy().transpose()
+        nest = PETSc.Mat().createNest([[K, None, GT], [None, S, minus_L], [G, minus_L, None]],
+                                      comm=self.comm)
+        self.index_sets = nest.getNestISs()[0]
+        A = nest.convert("aij")
+        if self.ksp is None:
+            self.ksp = PETSc.KSP().create(self.comm)
+            self.ksp.setType("preonly")
+            self.ksp.getPC().setType("lu")
+            self.ksp.getPC().setFactorSolverType("mumps")
+            self.ksp.setOptionsPrefix(self.prefix)
+            self.ksp.setFromOptions()
+        self.ksp.setOperators(A)
+        self.ksp.setUp()
+        self.A = A
+        self.rhs, self.sol = A.createVecRight(), A.createVecLeft()
+
+    def apply(self, pc: PETSc.PC, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        self.rhs.zeroEntries()
+        part = self.rhs.getSubVector(self.index_sets[0])
+        x.copy(part)
+        self.rhs.restoreSubVector(self.index_sets[0], part)
+        self.ksp.solve(self.rhs, self.sol)
+        part = self.sol.getSubVector(self.index_sets[0])
+        part.copy(y)
+        self.sol.restoreSubVector(self.index_sets[0], part)

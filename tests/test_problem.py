@@ -15,6 +15,7 @@ from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
 
 DEMOS = Path(__file__).resolve().parent.parent / "demos"
 LOCAL_KINDS = ["LmLS", "LmLS*", "LcLS*", "LcLS"]
+ALL_KINDS = ["GLS", "GLS*"] + LOCAL_KINDS
 
 
 def load(name):
@@ -40,7 +41,7 @@ def block_on_plane(comm=MPI.COMM_WORLD, n=(8, 4)):
     return fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags
 
 
-@pytest.mark.parametrize("kind", LOCAL_KINDS)
+@pytest.mark.parametrize("kind", ALL_KINDS)
 def test_block_on_rigid_plane_carries_the_applied_pressure(kind):
     V, tags = block_on_plane()
     problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
@@ -59,7 +60,7 @@ def test_patch_test_passes_with_the_consistent_scaling(dim):
     args = demo.parse_args(["--dim", str(dim)] + (["--fine", "0.25", "--coarse", "0.35"]
                                                    if dim == 3 else []))
     for orientation in ("finer-slave", "finer-master"):
-        for kind in LOCAL_KINDS:
+        for kind in ALL_KINDS:
             r = demo.run(args, orientation, kind, "consistent")
             assert r["max_relative_deviation"] < 1e-8, r
 
@@ -71,7 +72,8 @@ def test_seed_scaling_fails_the_patch_test():
     assert seed > 1e-3  # node-wise penalty ε W_A on a non-uniform mesh
 
 
-@pytest.mark.parametrize("starred, unstarred", [("LcLS*", "LcLS"), ("LmLS*", "LmLS")])
+@pytest.mark.parametrize("starred, unstarred", [("LcLS*", "LcLS"), ("LmLS*", "LmLS"),
+                                               ("GLS*", "GLS")])
 def test_starred_and_unstarred_kinds_give_the_same_problem_when_consistent(starred, unstarred):
     V, tags = block_on_plane(n=(10, 4))
     solutions = []
@@ -201,8 +203,6 @@ def test_bad_input_is_reported():
     with pytest.raises(ValueError, match="3D obstacle in a 2D mesh"):
         ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0, 0], [0, 0, 1]), penalty=1.0,
                        **common)
-    with pytest.raises(NotImplementedError, match="augmented form"):
-        ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, kind="GLS", **common)
     with pytest.raises(ValueError, match="unknown scaling"):
         ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, scaling="paper", **common)
     problem = ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, **common)
@@ -236,3 +236,53 @@ def test_hertz3d_mesh_file_and_ranks_reproduce_the_builtin_scene(tmp_path_factor
     for key in ("p0", "a", "contact_force"):
         assert from_file[key] == pytest.approx(builtin[key], rel=1e-8), key
         assert serial[key] == pytest.approx(builtin[key], rel=1e-8), key
+
+
+def test_gls_equals_the_dual_kind_when_the_gap_is_in_the_slave_space():
+    """Flat obstacle, P1 facets: d is piecewise linear, so L⁻¹∫N d and the dual
+    ∫M d/W both give the nodal values of d — the two problems coincide."""
+    V, tags = block_on_plane(n=(12, 4))
+    plane = RigidPlane([0, 0], [0.1, 1.0])  # tilted: the pressure is not uniform
+    solutions = []
+    for kind in ("GLS", "LcLS*", "LmLS"):
+        problem = ContactProblem(V, tags, 1, obstacle=plane, E=1.0, nu=0.3, kind=kind,
+                                 penalty=100.0, fixed={3: {0: 0.0}},
+                                 tractions={2: [0.0, -0.01]})
+        problem.solve(load_steps=2)
+        solutions.append(problem.u.x.array.copy())
+    scale = np.max(np.abs(solutions[0]))
+    assert np.max(np.abs(solutions[0] - solutions[1])) < 1e-10 * scale
+    assert np.max(np.abs(solutions[0] - solutions[2])) > 1e-6 * scale  # LmLS differs
+
+
+@pytest.mark.parametrize("kind", ["GLS", "GLS*"])
+def test_gls_newton_step_inverts_the_residual_derivative(kind):
+    """The augmented solve gives Δu with R'(u) Δu = r; R' by finite differences."""
+    V, tags = block_on_plane(n=(6, 3))
+    problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -2.0], 2.01), E=1.0,
+                             nu=0.3, kind=kind, penalty=50.0, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    problem._set_load(1.0)
+    problem.u.interpolate(lambda x: np.vstack([0.001 * x[1], -0.002 + 0.003 * x[0] ** 2]))
+    snes = problem._snes("gls_step_test_")
+    x0 = problem.u.vector.copy()
+    b0 = problem.b.duplicate()
+    problem._residual(None, x0, b0)
+    J = problem._total_matrix()
+    problem._jacobian(None, x0, J, J)
+    assert problem.mesh.comm.allreduce(int(np.sum(problem.nodal_gaps() > 0))) > 0
+    r = b0.duplicate()
+    r.array[:] = np.random.default_rng(2).normal(size=r.array.shape)
+    fem.petsc.set_bc(r, problem.bcs, scale=0.0)
+    du = r.duplicate()
+    problem._augmented.apply(None, r, du)
+    h = 1e-6 / du.norm()
+    x1 = x0.copy()
+    x1.axpy(h, du)
+    b1 = b0.duplicate()
+    problem._residual(None, x1, b1)
+    b1.axpy(-1.0, b0)
+    b1.scale(1 / h)
+    b1.axpy(-1.0, r)
+    assert b1.norm() < 1e-5 * r.norm()
+    snes.destroy()
