@@ -119,6 +119,8 @@ class ObstacleGap(_GapBase):
         tab = self.tabulation
         #: M̄_A at the quadrature points, per cell: (cells, points, functions)
         self.Mbar = np.einsum("cqb,cba->cqa", tab.phi, self.coefficients_std)
+        #: slave nodes with something below them (here: all; the obstacle is unbounded)
+        self.covered = self.basis.lumped_weights > 0
 
     def evaluate(self, u_nodes: FloatArray) -> tuple[FloatArray, PETSc.Mat, FloatArray]:
         """Nodal gaps, G, and the obstacle Hessian data at the quadrature points.
@@ -157,12 +159,14 @@ class ObstacleGap(_GapBase):
 class MortarGap(_GapBase):
     """Nodal gaps against an elastic master in the same mesh, small deformation.
 
-    Segmented once (in the configuration the coupling was built in):
-    ``d̄_A(u) = d̄_A⁰ + n_A·(Σ_B D̄_AB u_B − Σ_C M̄_AC u_C)``, linear in u.
+    Segmented once, in the configuration of ``reference`` (the displacement
+    the coupling was built with; None: the undeformed one), and linear about it:
+    ``d̄_A(u) = d̄_A⁰ + n_A·(Σ_B D̄_AB Δu_B − Σ_C M̄_AC Δu_C)``, ``Δu = u − reference``.
     """
 
     def __init__(self, coupling: MortarCoupling, kind: KindLike, penalty: float,
-                 scaling: str = "consistent"):
+                 scaling: str = "consistent", reference: Optional[PETSc.Vec] = None):
+        self.reference = reference
         super().__init__(coupling.slave, kind, penalty, scaling)
         if coupling.master.layout is not coupling.slave.layout and (
                 coupling.master.layout.size_global != coupling.slave.layout.size_global):
@@ -176,6 +180,9 @@ class MortarGap(_GapBase):
         g0 = np.einsum("pba,pb->pa", C, gn)
         slave_cells = self.slave.cells[coupling.pairs[:, 0]]
         self.gaps0 = self.slave.layout.sum_at_functions(slave_cells, g0)
+        #: slave nodes with master below them; the others have no gap at all
+        self.covered = self.slave.layout.sum_at_functions(
+            slave_cells, np.ones(slave_cells.shape)) > 0
         n = coupling.normals[slave_cells]                      # (pairs, ns, gdim)
         master_nodes = coupling.master_global_ids[coupling.master_cells[coupling.pairs[:, 1]]]
         bs = self.slave.gdim
@@ -192,6 +199,9 @@ class MortarGap(_GapBase):
 
     def evaluate(self, u: PETSc.Vec) -> FloatArray:
         """Nodal gaps at the local slave nodes for the displacement vector ``u``."""
+        if self.reference is not None:
+            u = u.copy()
+            u.axpy(-1.0, self.reference)
         Gu = self.G.createVecLeft()
         self.G.mult(u, Gu)
         return self.gaps0 + self.slave.layout.to_local(Gu)
@@ -223,6 +233,7 @@ class GlobalGap:
             self.weights = penalty * W ** 2
         self.dofs = inner.dofs
         self.mass = self.basis._solver
+        self.covered = inner.covered
 
     def nodal_pressures(self, gaps: FloatArray) -> FloatArray:
         """``p_A = ω_A⟨d̄_A⟩/W_A`` (coefficients of the traction in the PU basis GLS*)."""

@@ -206,6 +206,13 @@ class LagrangeSurface:
         return _kernels.element_node_normals(self.facet_type, x,
                                              self.cells.astype(np.int32))
 
+    def moved(self, displacement: FloatArray) -> "LagrangeSurface":
+        """The same surface with its nodes displaced (a new configuration)."""
+        return LagrangeSurface(self.reference.cell, self.reference.degree,
+                               self.x + displacement, self.cells, layout=self.layout,
+                               serendipity=self.reference.serendipity,
+                               quadratic_transform=self.reference.transform is not None)
+
     def reflected(self, which: npt.ArrayLike) -> "LagrangeSurface":
         """The same surface with the cells marked in ``which`` reflected (normal flipped)."""
         cells = self.cells.copy()

@@ -38,7 +38,9 @@ DEFAULT_OPTIONS = {
     "snes_rtol": 1e-11,
     # absolute residuals depend on the units: rely on the relative test
     "snes_atol": 1e-15,
-    "snes_stol": 0.0,
+    # a Newton step at roundoff size ends the iteration: rtol alone can be
+    # unreachable when the first residual is already small
+    "snes_stol": 1e-13,
     "snes_max_it": 40,
     # the first step of a contact problem often overshoots into the obstacle
     # before the active set settles: do not call that divergence
@@ -233,8 +235,12 @@ class ContactProblem:
             model = ObstacleGap(self.slave, self.obstacle, self.kind, self.penalty,
                                 self.scaling)
         else:
-            coupling = MortarCoupling(self.slave, self.master, u_nodes, u_nodes)
-            model = MortarGap(coupling, self.kind, self.penalty, self.scaling)
+            if u_nodes is None:
+                coupling = MortarCoupling(self.slave, self.master)
+            else:  # bases and segmentation in the configuration u (DESIGN.md §2)
+                coupling = MortarCoupling(self.slave.moved(u_nodes), self.master.moved(u_nodes))
+            reference = self.u.vector.copy() if u_nodes is not None else None
+            model = MortarGap(coupling, self.kind, self.penalty, self.scaling, reference)
         self.gap_model = (GlobalGap(model, self.kind, self.penalty, self.scaling)
                           if is_global(self.kind) else model)
         self._A_total: Optional[PETSc.Mat] = None
@@ -338,18 +344,20 @@ class ContactProblem:
         The generalized derivative of ⟨·⟩ at 0 is taken as 1, so touching
         nodes stiffen without pushing. If no node on any rank is active — a
         body that only touches at a point, with positive mortar functions, has
-        d̄ < 0 everywhere — the nodes within a tenth of their element length
-        of contact get stiffness too: otherwise the rigid-body mode that the
-        contact must hold makes the Jacobian singular. Once a node is active
-        the Jacobian is exact again.
+        d̄ < 0 everywhere — the covered nodes within a tenth of their element
+        length of contact get stiffness too: otherwise the rigid-body mode that
+        the contact must hold makes the Jacobian singular. Once a node is
+        active the Jacobian is exact again.
         """
-        active = gaps >= 0
+        # Nodes with no master below them have no gap (d̄ = 0 because nothing is
+        # integrated there): they are never active.
+        covered = self.gap_model.covered
+        active = covered & (gaps >= 0)
         n = self.slave.layout.num_owned
-        on_surface = self.gap_model.basis.lumped_weights > 0
-        if self.mesh.comm.allreduce(int(np.sum(active[:n] & on_surface[:n]))) == 0:
+        if self.mesh.comm.allreduce(int(np.sum(active[:n]))) == 0:
             W = self.gap_model.basis.lumped_weights
             length = np.power(np.maximum(W, 0.0), 1.0 / self.slave.tdim)
-            active = on_surface & (gaps >= -0.1 * length)
+            active = covered & (gaps >= -0.1 * length)
         return active.astype(np.float64)
 
     def _add(self, name: str, since: float) -> None:

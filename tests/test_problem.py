@@ -286,3 +286,34 @@ def test_gls_newton_step_inverts_the_residual_derivative(kind):
     b1.axpy(-1.0, r)
     assert b1.norm() < 1e-5 * r.norm()
     snes.destroy()
+
+
+def test_previous_configuration_resegments_and_still_passes_the_patch_test():
+    demo = load("patch_test")
+    args = demo.parse_args(["--dim", "2"])
+    from dolfinx import fem as _fem
+    domain, tags = demo.build_mesh(2, args.fine, args.coarse, 1, MPI.COMM_WORLD)
+    V = _fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
+                             nu=0.3, kind="LcLS*", penalty=1e3 / args.fine,
+                             basis_configuration="previous",
+                             fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
+                             tractions={demo.TOP: [0.0, -0.01]})
+    first = problem.gap_model
+    problem.solve(load_steps=3)
+    assert problem.gap_model is not first  # re-segmented after the steps
+    basis = problem.gap_model.basis       # built on the deformed slave surface
+    n = problem.slave.layout.num_owned
+    deformed_length = MPI.COMM_WORLD.allreduce(float(np.sum(basis.lumped_weights[:n])))
+    assert deformed_length > 1.0          # Poisson expansion of the compressed blocks
+    p = np.concatenate(MPI.COMM_WORLD.allgather(
+        problem.nodal_pressures()[:n][basis.lumped_weights[:n] > 0]))
+    # uniform (the patch test), and the load over the deformed interface up to the
+    # one-step lag of the "previous" configuration (strain increment ~0.13%)
+    assert np.max(p) / np.min(p) - 1 < 1e-8
+    assert abs(p[0] / (0.01 / deformed_length) - 1) < 3e-3
+
+
+def test_hertz2d_on_an_elastic_block():
+    figures = load("hertz2d").main(["--obstacle", "elastic", "--refine", "0.5"])
+    assert abs(figures["p0_error"]) < 0.03 and abs(figures["a_error"]) < 0.03, figures
