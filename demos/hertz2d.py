@@ -61,6 +61,7 @@ def build_mesh(args, a: float, comm: MPI.Comm):
     """Quarter disk (and block), graded towards the contact point (0, 0)."""
     import gmsh
     from dolfinx.io import gmshio
+    from dolfinx_mortar.gmsh_io import grade_towards_point
     R = args.radius
     h_contact = a / (40 * args.refine)
     gmsh.initialize(["", "-v", "0"])
@@ -93,21 +94,7 @@ def build_mesh(args, a: float, comm: MPI.Comm):
                     gmsh.model.addPhysicalGroup(1, curves, tag)
             for i, s in enumerate(surfaces):
                 gmsh.model.addPhysicalGroup(2, [s], 10 + i)
-            field = gmsh.model.mesh.field
-            point = occ.addPoint(0, 0, 0)
-            occ.synchronize()
-            field.add("Distance", 1)
-            field.setNumbers(1, "PointsList", [point])
-            field.add("Threshold", 2)
-            field.setNumber(2, "InField", 1)
-            field.setNumber(2, "SizeMin", h_contact)
-            field.setNumber(2, "SizeMax", R / 8)
-            field.setNumber(2, "DistMin", 1.5 * a)
-            field.setNumber(2, "DistMax", 1.5 * a + 40 * (R / 8))
-            field.setAsBackgroundMesh(2)
-            gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-            gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-            gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+            grade_towards_point((0, 0, 0), h_contact, R / 8, 1.5 * a, 1.5 * a + 40 * (R / 8))
             gmsh.model.mesh.generate(2)
             if args.degree == 2:
                 gmsh.model.mesh.setOrder(2)

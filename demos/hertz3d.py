@@ -69,6 +69,7 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
     also written to ``path`` (.msh) so that other codes can solve the same mesh."""
     import gmsh
     from dolfinx.io import gmshio
+    from dolfinx_mortar.gmsh_io import grade_towards_point
     R = args.radius
     h_contact = a / (8 * args.refine)
     gmsh.initialize(["", "-v", "0"])
@@ -95,21 +96,7 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
                 gmsh.model.setPhysicalName(2, tag, NAMES[tag - 1])
             gmsh.model.addPhysicalGroup(3, [body[0][1]], 1)
             gmsh.model.setPhysicalName(3, 1, "body_slave")
-            point = occ.addPoint(0, 0, 0)
-            occ.synchronize()
-            field = gmsh.model.mesh.field
-            field.add("Distance", 1)
-            field.setNumbers(1, "PointsList", [point])
-            field.add("Threshold", 2)
-            field.setNumber(2, "InField", 1)
-            field.setNumber(2, "SizeMin", h_contact)
-            field.setNumber(2, "SizeMax", R / 5)
-            field.setNumber(2, "DistMin", 1.3 * a)
-            field.setNumber(2, "DistMax", 1.3 * a + 12 * (R / 5))
-            field.setAsBackgroundMesh(2)
-            for option in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints",
-                           "MeshSizeFromCurvature"):
-                gmsh.option.setNumber(f"Mesh.{option}", 0)
+            grade_towards_point((0, 0, 0), h_contact, R / 5, 1.3 * a, 1.3 * a + 12 * (R / 5))
             gmsh.model.mesh.generate(3)
             if path is not None:
                 gmsh.write(path)

@@ -38,3 +38,26 @@ def read_gmsh(path: Union[str, Path], comm: MPI.Comm, gdim: int = 3):
     finally:
         gmsh.finalize()
     return domain, cell_tags, facet_tags, names
+
+
+def grade_towards_point(point: tuple, size_min: float, size_max: float,
+                        dist_min: float, dist_max: float) -> None:
+    """Make the current gmsh model's mesh size grow from ``size_min`` within
+    ``dist_min`` of ``point`` to ``size_max`` beyond ``dist_max`` (call on the
+    rank that builds the model, before meshing)."""
+    import gmsh
+    tag = gmsh.model.occ.addPoint(*point)
+    gmsh.model.occ.synchronize()
+    field = gmsh.model.mesh.field
+    distance = field.add("Distance")
+    field.setNumbers(distance, "PointsList", [tag])
+    threshold = field.add("Threshold")
+    field.setNumber(threshold, "InField", distance)
+    field.setNumber(threshold, "SizeMin", size_min)
+    field.setNumber(threshold, "SizeMax", size_max)
+    field.setNumber(threshold, "DistMin", dist_min)
+    field.setNumber(threshold, "DistMax", dist_max)
+    field.setAsBackgroundMesh(threshold)
+    # the field alone decides the size
+    for option in ("MeshSizeExtendFromBoundary", "MeshSizeFromPoints", "MeshSizeFromCurvature"):
+        gmsh.option.setNumber(f"Mesh.{option}", 0)

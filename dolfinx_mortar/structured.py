@@ -82,6 +82,18 @@ def flat_patch(cell: str, degree: int, nx: int, ny: int,
     return surface if up else surface.reflected(np.ones(len(cells), dtype=bool))
 
 
+def line_chain(breaks: np.ndarray, degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Parameters of the nodes and the cells (Basix order) of a chain of lines
+    between consecutive ``breaks``; P2 lines get their midpoints."""
+    n = len(breaks) - 1
+    if degree == 1:
+        return breaks, np.column_stack([np.arange(n), np.arange(1, n + 1)])
+    s = np.empty(2 * n + 1)
+    s[0::2] = breaks
+    s[1::2] = 0.5 * (breaks[:-1] + breaks[1:])
+    return s, np.column_stack([2 * np.arange(n), 2 * np.arange(n) + 2, 2 * np.arange(n) + 1])
+
+
 def flat_line(degree: int, n: int, bounds: Sequence[float] = (0.0, 1.0), y: float = 0.0,
               up: bool = True, jitter: float = 0.0, seed: int = 0) -> LagrangeSurface:
     """A straight chain of P1/P2 lines on y = const in 2D; ``up`` gives normals +y."""
@@ -89,14 +101,7 @@ def flat_line(degree: int, n: int, bounds: Sequence[float] = (0.0, 1.0), y: floa
     rng = np.random.default_rng(seed)
     breaks = np.linspace(x0, x1, n + 1)
     breaks[1:-1] += rng.uniform(-jitter, jitter, n - 1) * (x1 - x0) / n
-    if degree == 1:
-        s = breaks
-        cells = np.column_stack([np.arange(n), np.arange(1, n + 1)])
-    else:
-        s = np.empty(2 * n + 1)
-        s[0::2] = breaks
-        s[1::2] = 0.5 * (breaks[:-1] + breaks[1:])
-        cells = np.column_stack([2 * np.arange(n), 2 * np.arange(n) + 2, 2 * np.arange(n) + 1])
+    s, cells = line_chain(breaks, degree)
     x = np.column_stack([s, np.full(len(s), y)])
     surface = LagrangeSurface("interval", degree, x, cells)
     # left-to-right lines have the normal (t_y, -t_x) = -y

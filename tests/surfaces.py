@@ -4,22 +4,15 @@ from __future__ import annotations
 import numpy as np
 
 from dolfinx_mortar.lagrange import LagrangeSurface
-from dolfinx_mortar.structured import compact_nodes, flat_line, flat_patch, lattice_cells  # noqa: F401
+from dolfinx_mortar.structured import (compact_nodes, flat_line, flat_patch,  # noqa: F401
+                                       lattice_cells, line_chain)
 
 
 def curved_line(degree: int, n: int = 7, seed: int = 0) -> LagrangeSurface:
     """A wavy, non-uniform chain of P1/P2 line elements in 2D."""
     rng = np.random.default_rng(seed)
     breaks = np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0.05, 0.95, n - 1)]))
-    if degree == 1:
-        s = breaks
-        cells = np.column_stack([np.arange(n), np.arange(1, n + 1)])
-    else:
-        s = np.empty(2 * n + 1)
-        s[0::2] = breaks
-        s[1::2] = 0.5 * (breaks[:-1] + breaks[1:])
-        cells = np.column_stack([2 * np.arange(n), 2 * np.arange(n) + 2,
-                                 2 * np.arange(n) + 1])
+    s, cells = line_chain(breaks, degree)
     x = np.column_stack([s, 0.1 * np.sin(3.0 * s)])
     return LagrangeSurface("interval", degree, x, cells)
 
