@@ -3,8 +3,9 @@
 Built-in scene: a quarter of the lower half of a sphere (radius R, centre
 (0, 0, R); symmetry u_x = 0 at x = 0 and u_y = 0 at y = 0) carries the load F
 as a uniform traction F/(πR²) on its flat top z = R and touches the analytic
-rigid plane z = 0 (not meshed). The gmsh mesh is graded to size a/(8·refine)
-at the contact, a the Hertz radius.
+rigid plane z = 0 (not meshed), or with ``--obstacle elastic`` an elastic
+block [0, R]² × [−R, 0] fixed at its bottom. The gmsh mesh is graded to size
+a/(8·refine) at the contact, a the Hertz radius; ``--write-mesh`` saves it.
 
 ``--mesh FILE.msh`` reads a gmsh mesh instead, with the physical groups
 (volumes) ``body_slave``, ``body_master`` and (surfaces) ``slave``,
@@ -49,7 +50,11 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_contact (1e3)")
+    parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"),
+                        help="built-in scene: rigid plane, or an elastic block [0,R]²×[−R,0]")
     parser.add_argument("--mesh", default=None, help="gmsh .msh file with the named groups")
+    parser.add_argument("--write-mesh", default=None,
+                        help="also write the built-in mesh to this .msh file (for other codes)")
     parser.add_argument("--h-contact", type=float, default=None,
                         help="contact element size of --mesh (for the penalty; default: "
                              "the smallest slave facet)")
@@ -65,8 +70,9 @@ def hertz(E_star: float, R: float, F: float) -> dict:
 
 
 def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
-    """The built-in sphere octant, tagged with the names of a mesh file; optionally
-    also written to ``path`` (.msh) so that other codes can solve the same mesh."""
+    """The built-in sphere octant (and block), tagged with the names of a mesh
+    file; optionally also written to ``path`` (.msh) so that other codes can
+    solve the very same mesh."""
     import gmsh
     from dolfinx.io import gmshio
     from dolfinx_mortar.gmsh_io import grade_towards_point
@@ -79,23 +85,34 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
             sphere = occ.addSphere(0, 0, R, R)
             box = occ.addBox(0, 0, 0, R, R, R)
             body, _ = occ.intersect([(3, sphere)], [(3, box)])
+            volumes = {"body_slave": body[0][1]}
+            if args.obstacle == "elastic":
+                volumes["body_master"] = occ.addBox(0, 0, -R, R, R, R)
             occ.synchronize()
-            groups: dict = {SLAVE: [], LOAD: [], SYM_X: [], SYM_Y: []}
-            for _, s in gmsh.model.getBoundary(body, oriented=False):
-                x, y, z = occ.getCenterOfMass(2, s)
-                if abs(x) < 1e-6 * R:
-                    groups[SYM_X].append(s)
-                elif abs(y) < 1e-6 * R:
-                    groups[SYM_Y].append(s)
-                elif abs(z - R) < 1e-6 * R:
-                    groups[LOAD].append(s)
-                else:
-                    groups[SLAVE].append(s)
+            groups: dict = {tag: [] for tag in range(1, 7)}
+            for name, volume in volumes.items():
+                for _, s in gmsh.model.getBoundary([(3, volume)], oriented=False):
+                    x, y, z = occ.getCenterOfMass(2, s)
+                    if abs(x) < 1e-6 * R:
+                        groups[SYM_X].append(s)
+                    elif abs(y) < 1e-6 * R:
+                        groups[SYM_Y].append(s)
+                    elif name == "body_master":
+                        if abs(z) < 1e-6 * R:
+                            groups[MASTER].append(s)
+                        elif abs(z + R) < 1e-6 * R:
+                            groups[FIXED].append(s)
+                    elif abs(z - R) < 1e-6 * R:
+                        groups[LOAD].append(s)
+                    else:
+                        groups[SLAVE].append(s)
             for tag, surfaces in groups.items():
-                gmsh.model.addPhysicalGroup(2, surfaces, tag)
-                gmsh.model.setPhysicalName(2, tag, NAMES[tag - 1])
-            gmsh.model.addPhysicalGroup(3, [body[0][1]], 1)
-            gmsh.model.setPhysicalName(3, 1, "body_slave")
+                if surfaces:
+                    gmsh.model.addPhysicalGroup(2, surfaces, tag)
+                    gmsh.model.setPhysicalName(2, tag, NAMES[tag - 1])
+            for i, (name, volume) in enumerate(volumes.items()):
+                gmsh.model.addPhysicalGroup(3, [volume], i + 1)
+                gmsh.model.setPhysicalName(3, i + 1, name)
             grade_towards_point((0, 0, 0), h_contact, R / 5, 1.3 * a, 1.3 * a + 12 * (R / 5))
             gmsh.model.mesh.generate(3)
             if path is not None:
@@ -103,7 +120,9 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
         domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
     finally:
         gmsh.finalize()
-    return domain, facet_tags, h_contact
+    names = {name: i + 1 for i, name in enumerate(NAMES)
+             if args.obstacle == "elastic" or name not in ("master", "fixed")}
+    return domain, facet_tags, h_contact, names
 
 
 def read_mesh(path: str, comm: MPI.Comm):
@@ -148,10 +167,9 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     clock = time.perf_counter()
     E_star = args.E / (1 - args.nu ** 2)
     if args.mesh is None:
-        domain, facet_tags, h_contact = build_octant(args, hertz(E_star, args.radius,
-                                                                 args.force)["a"], comm)
-        names = {name: i + 1 for i, name in enumerate(NAMES) if i + 1 in (SLAVE, LOAD, SYM_X,
-                                                                           SYM_Y)}
+        factor = 2.0 if args.obstacle == "elastic" else 1.0  # E* halves for two bodies
+        a = hertz(E_star / factor, args.radius, args.force)["a"]
+        domain, facet_tags, h_contact, names = build_octant(args, a, comm, args.write_mesh)
     else:
         domain, facet_tags, names = read_mesh(args.mesh, comm)
         h_contact = args.h_contact

@@ -109,8 +109,11 @@ class ObstacleGap(_GapBase):
 
     def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: KindLike,
                  penalty: float, scaling: str = "consistent",
-                 quadrature_degree: Optional[int] = None):
+                 quadrature_degree: Optional[int] = None,
+                 reference: Optional[FloatArray] = None):
         super().__init__(slave, kind, penalty, scaling)
+        #: nodal displacement that moved ``slave`` to its configuration (or None)
+        self.reference = reference
         if obstacle.gdim != slave.gdim:
             raise ValueError(f"a {obstacle.gdim}D obstacle cannot touch a {slave.gdim}D body")
         self.obstacle = obstacle
@@ -128,6 +131,8 @@ class ObstacleGap(_GapBase):
         ``u_nodes``: displacement at the local slave-layout nodes, (nodes, gdim).
         """
         tab, cells = self.tabulation, self.slave.cells
+        if self.reference is not None:  # the surface already carries the reference
+            u_nodes = u_nodes - self.reference
         u_q = np.einsum("cqb,cbk->cqk", tab.phi, u_nodes[cells])
         x = (tab.points + u_q).reshape(-1, self.slave.gdim)
         nc, nq, nd = tab.phi.shape

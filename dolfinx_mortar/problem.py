@@ -121,8 +121,9 @@ class ContactProblem:
         ``"nodal"`` (default); ``"pointwise"`` is not implemented yet.
     basis_configuration
         ``"initial"`` (default): bases and segmentation in the reference
-        configuration; ``"previous"``: the elastic master is re-segmented in
-        the last converged configuration at every load step.
+        configuration; ``"previous"``: bases (and, for an elastic master, the
+        segmentation) rebuilt in the last converged configuration after every
+        load step.
     fixed
         ``{tag: {component: value}}``: prescribed displacement components at
         load factor 1 (scaled by the load factor).
@@ -232,8 +233,9 @@ class ContactProblem:
         """(Re)build the gap model; for an elastic master in the configuration u."""
         clock = time.perf_counter()
         if self.obstacle is not None:
-            model = ObstacleGap(self.slave, self.obstacle, self.kind, self.penalty,
-                                self.scaling)
+            slave = self.slave if u_nodes is None else self.slave.moved(u_nodes)
+            model = ObstacleGap(slave, self.obstacle, self.kind, self.penalty, self.scaling,
+                                reference=u_nodes)
         else:
             if u_nodes is None:
                 coupling = MortarCoupling(self.slave, self.master)
@@ -473,7 +475,7 @@ class ContactProblem:
                 self._write_step(target)
             if on_step is not None:
                 on_step(self, s)
-            if self.basis_configuration == "previous" and self.master is not None:
+            if self.basis_configuration == "previous":
                 self._segment(nodal_displacement(self.slave, self.u))
                 snes.destroy()
                 snes = self._snes(prefix)

@@ -317,3 +317,37 @@ def test_previous_configuration_resegments_and_still_passes_the_patch_test():
 def test_hertz2d_on_an_elastic_block():
     figures = load("hertz2d").main(["--obstacle", "elastic", "--refine", "0.5"])
     assert abs(figures["p0_error"]) < 0.03 and abs(figures["a_error"]) < 0.03, figures
+
+
+def test_previous_configuration_with_a_rigid_obstacle():
+    V, tags = block_on_plane()
+    results = {}
+    for configuration in ("initial", "previous"):
+        problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0,
+                                 nu=0.3, kind="LcLS*", penalty=1e4, fixed={3: {0: 0.0}},
+                                 tractions={2: [0.0, -0.01]},
+                                 basis_configuration=configuration)
+        first = problem.gap_model
+        problem.solve(load_steps=3)
+        results[configuration] = (problem.u.x.array.copy(), problem.gap_model is first)
+    (u0, same0), (u1, same1) = results["initial"], results["previous"]
+    assert same0 and not same1
+    # a flat obstacle under uniform pressure: the contact stays uniform, and the
+    # two configurations differ only by the Poisson expansion of the contact face
+    assert np.max(np.abs(u1 - u0)) < 1e-2 * np.max(np.abs(u0))
+
+
+def test_hertz3d_two_elastic_bodies_from_a_mesh_file(tmp_path_factory):
+    demo = load("hertz3d")
+    comm = MPI.COMM_WORLD
+    path = comm.bcast(str(tmp_path_factory.mktemp("msh2") / "two_bodies.msh")
+                      if comm.rank == 0 else None)
+    builtin = demo.run(demo.parse_args(["--obstacle", "elastic", "--refine", "0.6",
+                                        "--load-steps", "2", "--write-mesh", path]), comm)
+    from_file = demo.run(demo.parse_args(["--mesh", path, "--load-steps", "2",
+                                          "--h-contact", str(builtin["h_contact"])]), comm)
+    assert from_file["p0"] == pytest.approx(builtin["p0"], rel=1e-8)
+    assert abs(builtin["p0_error"]) < 0.15 and abs(builtin["a_error"]) < 0.10, builtin
+    moved = demo.run(demo.parse_args(["--mesh", path, "--load-steps", "2",
+                                      "--load-displacement", "0.002"]), comm)
+    assert moved["contact_force"] > 0 and abs(moved["p0_error"]) < 0.15, moved
