@@ -224,7 +224,9 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
     contact_force, force, h_contact = figures["contact_force"], figures["force"], figures["h_contact"]
     dofs, wall = figures["dofs"], figures["wall_time"]
     if comm.rank == 0:
-        print(f"Hertz 3D ({'mesh ' + args.mesh if args.mesh else 'sphere on a rigid plane'}, "
+        scene = ("mesh " + args.mesh if args.mesh else "sphere on an elastic block"
+                 if args.obstacle == "elastic" else "sphere on a rigid plane")
+        print(f"Hertz 3D ({scene}, "
               f"{args.kind}, {dofs} dofs, {comm.size} rank(s))")
         print(f"  peak pressure p0 = {figures['p0']:.6g}  (Hertz {figures['hertz_p0']:.6g}, "
               f"error {100 * figures['p0_error']:+.2f}%)")
