@@ -187,7 +187,7 @@ def time_phases(kind: str, surface: Any) -> tuple[float, ...]:
 
 
 def _release_solver(solver: Optional[MassMatrixSolver]) -> None:
-    # MUMPS factors of a 1e6-function L take hundreds of MB; free them now rather
+    # MUMPS needs ~2 GB for a 1e6-function B-spline L (INFOG(22)); free it now rather
     # than whenever the garbage collector gets to the petsc4py objects.
     if solver is not None:
         solver.ksp.destroy()

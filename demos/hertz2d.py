@@ -122,7 +122,6 @@ def contact_results(problem, ref: dict) -> dict:
     c1, c0 = np.polyfit(xs[inner] ** 2, ps[inner] ** 2, 1)
     a_fit = float(np.sqrt(-c0 / c1)) if c1 < 0 < c0 else float("nan")
     # L2 error of p̂ = Σ N_A p_A over [0, a_Hertz] on the slave quadrature points
-    tab = problem.gap_model.basis.tabulation if hasattr(problem.gap_model, "basis") else None
     tab = slave.tabulate(6, transformed=False)
     p_hat = np.einsum("cqb,cb->cq", tab.phi, p[slave.cells])
     xq = tab.points[..., 0]
