@@ -63,10 +63,9 @@ class MortarBasis:
         self.quadrature_degree = quadrature_degree or surface.default_quadrature_degree()
         tab = surface.tabulate(self.quadrature_degree)
         self.tabulation: Tabulation = tab
+        self._element_mass: Optional[FloatArray] = None
         #: W^e_A = ∫_e N_A dA, shape (cells, functions)
         self.element_weights = _kernels.element_integrals(tab.phi, tab.weights)
-        #: L^e_AB = ∫_e N_A N_B dA, shape (cells, functions, functions)
-        self.element_mass = _kernels.element_mass_matrices(tab.phi, tab.weights)
         #: W_A = ∫ N_A dA at owned and ghost functions
         self.lumped_weights = self.layout.sum_at_functions(self.cells, self.element_weights)
         nodal_at_cells = self.lumped_weights[self.cells]
@@ -79,10 +78,24 @@ class MortarBasis:
                 self._solver: Optional[MassMatrixSolver] = MassMatrixSolver(self.layout, mass)
             else:
                 self._solver = None
+                dual = self.kind in (BasisKind.LcLS_star, BasisKind.LcLS)
+                mass = self.element_mass if dual else np.zeros((0, 0, 0))
                 self.coefficients = _kernels.basis_coefficients(
-                    self.kind, self.element_mass, self.element_weights, nodal_at_cells)
+                    self.kind, mass, self.element_weights, nodal_at_cells)
         except ValueError as err:
             raise ValueError(f"{surface.description}: {err}{_hint(surface)}") from None
+
+    @property
+    def element_mass(self) -> FloatArray:
+        """L^e_AB = ∫_e N_A N_B dA, shape (cells, functions, functions).
+
+        Computed on first use: the lumped kinds never need it, and at 1e6
+        quadratic elements it is 0.65 GB.
+        """
+        if self._element_mass is None:
+            tab = self.tabulation
+            self._element_mass = _kernels.element_mass_matrices(tab.phi, tab.weights)
+        return self._element_mass
 
     # -- integrals ---------------------------------------------------------------
     def element_integrals(self, f: FieldLike) -> FloatArray:

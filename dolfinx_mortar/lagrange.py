@@ -261,9 +261,10 @@ class LagrangeSurface:
         N, dN = self.reference.tabulate(X, transformed=transformed)
         N_geo, _ = self.reference.tabulate(X, transformed=False)
         coords = self.x[self.cells]  # (nc, nd, gdim)
-        points = np.einsum("qk,ckg->cqg", N_geo, coords)
-        J = np.einsum("qtk,ckg->cqgt", dN, coords)
-        measure = _surface_measure(J)
+        # matmul broadcasts over cells and is several times faster than einsum here
+        points = N_geo @ coords
+        tangents = [dN[:, t, :] @ coords for t in range(self.tdim)]  # (nc, nq, gdim) each
+        measure = _measure_from_tangents(tangents)
         nc, nq = len(self.cells), len(X)
         phi = np.broadcast_to(N, (nc, nq, N.shape[1]))
         return Tabulation(phi=np.ascontiguousarray(phi), weights=measure * wq[None, :],
@@ -275,6 +276,17 @@ class LagrangeSurface:
         cells = np.asarray(cells, dtype=np.int64)
         N, _, _ = self.tabulate_at(cells, X)
         return cells, N
+
+
+def _measure_from_tangents(tangents: list) -> FloatArray:
+    """|t₀| (lines) or sqrt(|t₀|²|t₁|² − (t₀·t₁)²) (surfaces): det(JᵀJ) in closed form."""
+    if len(tangents) == 1:
+        return np.linalg.norm(tangents[0], axis=-1)
+    t0, t1 = tangents
+    E = np.einsum("...g,...g->...", t0, t0)
+    F = np.einsum("...g,...g->...", t0, t1)
+    G = np.einsum("...g,...g->...", t1, t1)
+    return np.sqrt(np.maximum(E * G - F * F, 0.0))
 
 
 def _surface_measure(J: FloatArray) -> FloatArray:

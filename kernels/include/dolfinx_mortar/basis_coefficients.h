@@ -38,7 +38,8 @@ check_lumped_weights(BasisKind kind,
 ///   LcLS*: C^e = (L^e)⁻¹ diag(W^e);  LcLS: C^e = (L^e)⁻¹ diag(W^e) diag(1/W).
 ///
 /// @param[in] kind A local kind (not GLS/GLS*, which have global support)
-/// @param[in] element_mass L^e, shape (cells, functions, functions)
+/// @param[in] element_mass L^e, shape (cells, functions, functions); only
+/// read for the dual kinds (LcLS*, LcLS), may be empty for the others
 /// @param[in] element_weights W^e, shape (cells, functions)
 /// @param[in] nodal_weights Global W_A gathered at each cell's functions,
 /// shape (cells, functions)
