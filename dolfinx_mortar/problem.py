@@ -48,6 +48,9 @@ DEFAULT_OPTIONS = {
     "ksp_type": "preonly",
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
+    # MUMPS sizes its workspace from the analysis; parallel pivoting can exceed
+    # it (INFOG(1) = -9). 100% extra costs memory only.
+    "mat_mumps_icntl_14": 100,
 }
 
 

@@ -349,5 +349,6 @@ def test_hertz3d_two_elastic_bodies_from_a_mesh_file(tmp_path_factory):
     assert from_file["p0"] == pytest.approx(builtin["p0"], rel=1e-8)
     assert abs(builtin["p0_error"]) < 0.15 and abs(builtin["a_error"]) < 0.10, builtin
     moved = demo.run(demo.parse_args(["--mesh", path, "--load-steps", "2",
-                                      "--load-displacement", "0.002"]), comm)
+                                      "--load-displacement", "0.002",
+                                      "--h-contact", str(builtin["h_contact"])]), comm)
     assert moved["contact_force"] > 0 and abs(moved["p0_error"]) < 0.15, moved
