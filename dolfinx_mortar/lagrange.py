@@ -245,8 +245,8 @@ class LagrangeSurface:
         N_geo, _ = self.reference.tabulate(X, transformed=False)
         coords = self.x[self.cells[cells]]  # (n, nd, gdim)
         x = np.einsum("nk,nkg->ng", N_geo, coords)
-        J = np.einsum("ntk,nkg->ngt", dN, coords)
-        return N, x, _surface_measure(J)
+        tangents = [np.einsum("nk,nkg->ng", dN[:, t, :], coords) for t in range(self.tdim)]
+        return N, x, _measure_from_tangents(tangents)
 
     def tabulate(self, quadrature_degree: Optional[int] = None,
                  transformed: bool = True) -> Tabulation:
@@ -287,11 +287,3 @@ def _measure_from_tangents(tangents: list) -> FloatArray:
     F = np.einsum("...g,...g->...", t0, t1)
     G = np.einsum("...g,...g->...", t1, t1)
     return np.sqrt(np.maximum(E * G - F * F, 0.0))
-
-
-def _surface_measure(J: FloatArray) -> FloatArray:
-    """sqrt(det(JᵀJ)) for Jacobians of shape (..., gdim, tdim)."""
-    G = np.einsum("...gi,...gj->...ij", J, J)
-    if G.shape[-1] == 1:
-        return np.sqrt(G[..., 0, 0])
-    return np.sqrt(np.linalg.det(G))
