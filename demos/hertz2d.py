@@ -22,13 +22,17 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
+from dolfinx_mortar.cli import parse_args_and_petsc_options
 from dolfinx_mortar.output import write_json
 
 SLAVE, MASTER, SYMMETRY, LOAD, FIXED = 1, 2, 3, 4, 5
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0],
+        epilog="PETSc options (single dash) go to the options database, e.g. "
+               "-dolfinx_mortar_snes_monitor -dolfinx_mortar_snes_linesearch_type bt")
     parser.add_argument("--radius", type=float, default=1.0, help="cylinder radius R (1)")
     parser.add_argument("--E", type=float, default=1.0, help="Young's modulus (1)")
     parser.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
@@ -40,13 +44,15 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         help="displacement degree (1)")
     parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
     parser.add_argument("--scaling", default="consistent", choices=("consistent", "seed"))
+    parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
+                        help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"))
     parser.add_argument("--load-steps", type=int, default=4, help="load steps (4)")
     parser.add_argument("--output", default=None, help="XDMF file for the steps")
     parser.add_argument("--json", default=None, help="write the key figures as JSON here")
-    return parser.parse_args(argv)
+    return parse_args_and_petsc_options(parser, argv)
 
 
 def hertz(args) -> dict:
@@ -129,8 +135,7 @@ def contact_results(problem, ref: dict) -> dict:
     near = (xq < 1.5 * ref["a"]) & (tab.points[..., 1] < 0.5 * problem_radius(problem))
     err2 = comm.allreduce(float(np.sum((tab.weights * (p_hat - exact) ** 2)[near])))
     ref2 = comm.allreduce(float(np.sum((tab.weights * exact ** 2)[near])))
-    total = comm.allreduce(float(np.sum(problem.gap_model.weights[:n]
-                                        * np.maximum(problem.nodal_gaps()[:n], 0))))
+    total = problem.contact_force()
     return {"p0": p0, "a": a_fit, "a_last_active_node": float(np.max(xs)),
             "l2_error": float(np.sqrt(err2 / ref2)), "contact_force": total,
             "active_nodes": int(len(xs))}
@@ -160,6 +165,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
         fixed[FIXED] = {0: 0.0, 1: 0.0}
     problem = ContactProblem(V, facet_tags, SLAVE, E=args.E, nu=args.nu, kind=args.kind,
                              penalty=args.penalty * args.E / h_contact, scaling=args.scaling,
+                             active_set=args.active_set,
                              fixed=fixed,
                              tractions={LOAD: [0.0, -args.force / (2 * args.radius)]},
                              **kwargs)
@@ -175,6 +181,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
         "dofs": int(dofs), "newton_iterations": result.newton_iterations,
         "load_steps": len(result.steps), "wall_time": wall, "h_contact": h_contact,
         "kind": args.kind, "scaling": args.scaling, "obstacle": args.obstacle,
+        "active_set": args.active_set,
         "degree": args.degree, "refine": args.refine, "ranks": comm.size,
     })
     if comm.rank == 0:

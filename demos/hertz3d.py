@@ -30,6 +30,7 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
+from dolfinx_mortar.cli import parse_args_and_petsc_options
 from dolfinx_mortar.output import write_json
 
 NAMES = ("slave", "master", "fixed", "load", "sym_x", "sym_y")
@@ -37,7 +38,10 @@ SLAVE, MASTER, FIXED, LOAD, SYM_X, SYM_Y = range(1, 7)
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0],
+        epilog="PETSc options (single dash) go to the options database, e.g. "
+               "-dolfinx_mortar_snes_monitor -dolfinx_mortar_snes_linesearch_type bt")
     parser.add_argument("--radius", type=float, default=1.0, help="sphere radius R (1)")
     parser.add_argument("--E", type=float, default=1.0, help="Young's modulus (1)")
     parser.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
@@ -48,6 +52,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--refine", type=float, default=1.0,
                         help="mesh density factor: contact size a/(8·refine) (1)")
     parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
+    parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
+                        help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"),
@@ -61,7 +67,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--load-steps", type=int, default=3, help="load steps (3)")
     parser.add_argument("--output", default=None, help="XDMF file for the steps")
     parser.add_argument("--json", default=None, help="write the key figures as JSON here")
-    return parser.parse_args(argv)
+    return parse_args_and_petsc_options(parser, argv)
 
 
 def hertz(E_star: float, R: float, F: float) -> dict:
@@ -199,13 +205,12 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
         E_star /= 2
     problem = ContactProblem(V, facet_tags, names["slave"], E=args.E, nu=args.nu,
                              kind=args.kind, penalty=args.penalty * args.E / h_contact,
+                             active_set=args.active_set,
                              fixed=fixed, tractions=tractions, **kwargs)
     result = problem.solve(load_steps=args.load_steps, output=args.output,
                            progress=comm.rank == 0)
     wall = time.perf_counter() - clock
-    n = problem.slave.layout.num_owned
-    contact_force = quarter * comm.allreduce(float(np.sum(
-        problem.gap_model.weights[:n] * np.maximum(problem.nodal_gaps()[:n], 0.0))))
+    contact_force = quarter * problem.contact_force()
     force = args.force if args.load_displacement is None else contact_force
     figures = contact_results(problem, E_star, args.radius, force)
     dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
@@ -213,6 +218,7 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
                     "load_steps": len(result.steps), "wall_time": wall,
                     "h_contact": h_contact, "contact_force": contact_force, "force": force,
                     "kind": args.kind, "refine": args.refine, "ranks": comm.size,
+                    "active_set": args.active_set,
                     "mesh": args.mesh})
     return figures
 

@@ -17,6 +17,7 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
+from dolfinx_mortar.cli import parse_args_and_petsc_options
 from dolfinx_mortar.output import write_json
 
 LOWER_TOP, UPPER_BOTTOM, TOP, BOTTOM, SYM_X, SYM_Y = 1, 2, 3, 4, 5, 6
@@ -24,7 +25,10 @@ ALL_KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0],
+        epilog="PETSc options (single dash) go to the options database, e.g. "
+               "-dolfinx_mortar_snes_monitor -dolfinx_mortar_snes_linesearch_type bt")
     parser.add_argument("--dim", type=int, default=2, choices=(2, 3))
     parser.add_argument("--degree", type=int, default=1, choices=(1, 2))
     parser.add_argument("--fine", type=float, default=0.09, help="finer element size (0.09)")
@@ -33,13 +37,15 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         choices=("finer-slave", "finer-master", "both"))
     parser.add_argument("--kinds", nargs="+", default=list(ALL_KINDS))
     parser.add_argument("--scalings", nargs="+", default=["consistent", "seed"])
+    parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
+                        help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
     parser.add_argument("--pressure", type=float, default=0.01, help="applied pressure (0.01)")
     parser.add_argument("--E", type=float, default=1.0)
     parser.add_argument("--nu", type=float, default=0.3)
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="ε as a multiple of E / fine size (1e3)")
     parser.add_argument("--json", default=None, help="write the results as JSON here")
-    return parser.parse_args(argv)
+    return parse_args_and_petsc_options(parser, argv)
 
 
 def build_mesh(dim: int, h_lower: float, h_upper: float, degree: int, comm: MPI.Comm):
@@ -103,6 +109,7 @@ def run(args, orientation: str, kind: str, scaling: str, comm=MPI.COMM_WORLD) ->
     problem = ContactProblem(V, facet_tags, LOWER_TOP, master_tag=UPPER_BOTTOM, E=args.E,
                              nu=args.nu, kind=kind, scaling=scaling,
                              penalty=args.penalty * args.E / fine, fixed=fixed,
+                             active_set=args.active_set,
                              tractions={TOP: traction},
                              quadratic_transform=(args.degree == 2 and d == 3))
     result = problem.solve(load_steps=1)

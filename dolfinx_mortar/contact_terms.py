@@ -80,15 +80,17 @@ class _GapBase:
         #: M̄ = N_std C_std on each slave cell (N_std: the displacement's basis)
         self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
 
-    def nodal_pressures(self, gaps: FloatArray) -> FloatArray:
+    def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """Pressure coefficients ``p_A`` of the contact traction in a PU basis.
 
         The traction is ``Σ_A ω_A ⟨d_A⟩ M_A`` with ``M`` the gap basis. A non-PU
         ``M_A`` is ``M*_A / W_A``, so ``p_A = ω_A ⟨d_A⟩ / W_A`` (in the
         consistent scaling ``ε⟨d̄_A⟩``); a PU gap basis (seed scaling with a
-        starred kind) gives ``p_A = ω_A ⟨d_A⟩`` directly.
+        starred kind) gives ``p_A = ω_A ⟨d_A⟩`` directly. ``positive_part=False``
+        takes ``gaps`` as they are (the pointwise active set's ``d̄⁺``, which is
+        already an integral of ⟨d⟩ and may be negative for dual kinds).
         """
-        force = self.weights * np.maximum(gaps, 0.0)
+        force = self.weights * (np.maximum(gaps, 0.0) if positive_part else gaps)
         if is_partition_of_unity(self.basis.kind):
             return force
         W = self.basis.lumped_weights
@@ -201,6 +203,11 @@ class MortarGap(_GapBase):
         cols = np.concatenate([slave_dofs, master_dofs], axis=1).reshape(npairs, width)
         self.G = assemble_blocks(self.slave.layout, slave_cells, self.dofs, cols,
                                  blocks.reshape(npairs, ns, width))
+        #: the segment points for the pointwise active set (None: nodal only)
+        self.points = None
+        if coupling.points is not None:
+            from dolfinx_mortar.pointwise import MortarPointGaps
+            self.points = MortarPointGaps(self)
 
     def evaluate(self, u: PETSc.Vec) -> FloatArray:
         """Nodal gaps at the local slave nodes for the displacement vector ``u``."""
@@ -240,8 +247,8 @@ class GlobalGap:
         self.mass = self.basis._solver
         self.covered = inner.covered
 
-    def nodal_pressures(self, gaps: FloatArray) -> FloatArray:
+    def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """``p_A = ω_A⟨d̄_A⟩/W_A`` (coefficients of the traction in the PU basis GLS*)."""
         W = self.basis.lumped_weights
-        return np.divide(self.weights * np.maximum(gaps, 0.0), W, out=np.zeros_like(W),
-                         where=W > 0)
+        force = self.weights * (np.maximum(gaps, 0.0) if positive_part else gaps)
+        return np.divide(force, W, out=np.zeros_like(W), where=W > 0)

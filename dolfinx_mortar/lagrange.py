@@ -139,7 +139,11 @@ class ReferenceLagrange:
         The gradients are of the untransformed basis: they serve the geometry
         map, which is always isoparametric in the standard basis.
         """
-        t = self._element.tabulate(1, np.asarray(X, dtype=np.float64))[..., 0]
+        X = np.asarray(X, dtype=np.float64)
+        if len(X) == 0:  # Basix aborts the process on an empty point set
+            nd = self.num_functions
+            return np.zeros((0, nd)), np.zeros((0, self.tdim, nd))
+        t = self._element.tabulate(1, X)[..., 0]
         if self._to_nodal is not None:
             t = t @ self._to_nodal
         values, grads = t[0], np.moveaxis(t[1:], 0, 1)

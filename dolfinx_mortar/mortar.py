@@ -140,6 +140,9 @@ class MortarCoupling:
         are not polynomials and the integrals are exact only up to quadrature.
     opposing_normals_only
         Skip master facets that face the same way as the slave facet.
+    keep_points
+        Also keep every segment quadrature point (weight, gap, normal, slave
+        and master basis values) in :attr:`points`, for the pointwise active set.
     """
 
     def __init__(self, slave: LagrangeSurface, master: LagrangeSurface,
@@ -147,7 +150,7 @@ class MortarCoupling:
                  master_displacement: Optional[FloatArray] = None,
                  search_radius: Optional[float] = None,
                  quadrature_degree: Optional[int] = None,
-                 opposing_normals_only: bool = True):
+                 opposing_normals_only: bool = True, keep_points: bool = False):
         if slave.gdim != master.gdim:
             raise ValueError(f"slave ({slave.gdim}D) and master ({master.gdim}D) surfaces "
                              "live in different dimensions")
@@ -188,7 +191,8 @@ class MortarCoupling:
         points, weights = _segment_quadrature(slave.tdim, degree)
         r = _kernels.mortar_integrals(slave.facet_type, xs, slave_cells, self.normals,
                                       master.facet_type, master_copy.x, master_copy.cells,
-                                      candidates, points, weights, opposing_normals_only)
+                                      candidates, points, weights, opposing_normals_only,
+                                      keep_points=keep_points)
         self.timings["segmentation"] = time.perf_counter() - clock
         self.num_candidates = len(candidates)
         self.failed_projections = comm.allreduce(int(r["failed_projections"]))
@@ -205,6 +209,11 @@ class MortarCoupling:
         else:
             self.D_pairs, self.M_pairs, self.gap_pairs = r["D"], r["M"], r["gap"]
         self.area_pairs = r["area"]
+        #: per segment quadrature point (keep_points): pair, weight, gap d,
+        #: unit normal n, standard slave basis N, master basis N^m; else None
+        self.points: Optional[dict] = (
+            {key[len("point_"):]: r[key] for key in r if key.startswith("point_")}
+            if keep_points else None)
         #: covered area of every local slave cell
         self.covered_area = np.bincount(self.pairs[:, 0], weights=self.area_pairs,
                                         minlength=len(slave.cells))

@@ -24,7 +24,10 @@ from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_
 from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
 from dolfinx_mortar.kinds import KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.mortar import MortarCoupling
+from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.obstacles import RigidObstacle
+from dolfinx_mortar.pointwise import obstacle_positive_gaps
+from dolfinx_mortar.surface_output import SlaveSurfaceOutput, surface_output_path
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -52,6 +55,24 @@ DEFAULT_OPTIONS = {
     # it (INFOG(1) = -9). 100% extra costs memory only.
     "mat_mumps_icntl_14": 100,
 }
+
+
+@dataclass
+class ContactState:
+    """The contact terms at one displacement.
+
+    ``R_c = Gᵀ force``. ``G`` is the masked derivative of the nodal gaps d̄
+    (Ĝ of ĝ for GLS kinds); ``K_curv`` the masked curvature matrix or None.
+    With the pointwise active set, ``gaps_plus`` = d̄⁺ and ``G_plus`` its
+    derivative; otherwise both are None.
+    """
+
+    gaps: FloatArray
+    G: PETSc.Mat
+    force: FloatArray
+    K_curv: Optional[PETSc.Mat]
+    gaps_plus: Optional[FloatArray] = None
+    G_plus: Optional[PETSc.Mat] = None
 
 
 class ContactDivergenceError(RuntimeError):
@@ -121,7 +142,11 @@ class ContactProblem:
     scaling
         ``"consistent"`` (default) or ``"seed"``.
     active_set
-        ``"nodal"`` (default); ``"pointwise"`` is not implemented yet.
+        ``"nodal"`` (default): the penalty acts on ``⟨d̄_A⟩``;
+        ``"pointwise"``: ``p_A = ε ∫ M̄_A ⟨d⟩``, integrated only where the slave
+        penetrates (cells split at d = 0 against a rigid obstacle; the segment
+        quadrature points against an elastic master), with an unsymmetric
+        exact Jacobian (:mod:`dolfinx_mortar.pointwise`).
     basis_configuration
         ``"initial"`` (default): bases and segmentation in the reference
         configuration; ``"previous"``: bases (and, for an elastic master, the
@@ -154,9 +179,6 @@ class ContactProblem:
             raise ValueError(f"need E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
         if active_set not in ACTIVE_SETS:
             raise ValueError(f"unknown active set '{active_set}'; expected {ACTIVE_SETS}")
-        if active_set == "pointwise":
-            raise NotImplementedError("the pointwise active set (elements split at d = 0) "
-                                      "is not implemented yet; use active_set='nodal'")
         if basis_configuration not in CONFIGURATIONS:
             raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
                              f"expected {CONFIGURATIONS}")
@@ -183,6 +205,7 @@ class ContactProblem:
         self.kind = parse_kind(kind)
         self.penalty, self.scaling = float(penalty), scaling
         self.basis_configuration = basis_configuration
+        self.active_set = active_set
         self.obstacle = obstacle
         self.load = fem.Constant(mesh, PETSc.ScalarType(0.0))
 
@@ -240,10 +263,12 @@ class ContactProblem:
             model = ObstacleGap(slave, self.obstacle, self.kind, self.penalty, self.scaling,
                                 reference=u_nodes)
         else:
+            keep = self.active_set == "pointwise"
             if u_nodes is None:
-                coupling = MortarCoupling(self.slave, self.master)
+                coupling = MortarCoupling(self.slave, self.master, keep_points=keep)
             else:  # bases and segmentation in the configuration u (DESIGN.md §2)
-                coupling = MortarCoupling(self.slave.moved(u_nodes), self.master.moved(u_nodes))
+                coupling = MortarCoupling(self.slave.moved(u_nodes), self.master.moved(u_nodes),
+                                          keep_points=keep)
             reference = self.u.vector.copy() if u_nodes is not None else None
             model = MortarGap(coupling, self.kind, self.penalty, self.scaling, reference)
         self.gap_model = (GlobalGap(model, self.kind, self.penalty, self.scaling)
@@ -261,32 +286,39 @@ class ContactProblem:
             self._bc_mask = m
         return self._bc_mask
 
-    def _contact(self) -> tuple[FloatArray, PETSc.Mat, FloatArray, Optional[PETSc.Mat]]:
-        """Contact state at the current u.
-
-        Returns the nodal gaps d̄, the masked derivative G of the gaps the
-        model assembles (Ĝ for GLS kinds), the nodal vector f with
-        ``R_c = Gᵀ f``, and the masked curvature matrix (or None).
-        """
+    def _contact(self) -> "ContactState":
+        """Contact state at the current u (see :class:`ContactState`)."""
         model = self.gap_model
         inner = model.inner if isinstance(model, GlobalGap) else model
+        pointwise = self.active_set == "pointwise"
         x = None
+        gaps_plus = G_plus = None
         if isinstance(inner, ObstacleGap):
-            gaps, G, x = inner.evaluate(nodal_displacement(self.slave, self.u))
+            u_nodes = nodal_displacement(self.slave, self.u)
+            gaps, G, x = inner.evaluate(u_nodes)
+            if pointwise:
+                gaps_plus, G_plus = obstacle_positive_gaps(inner, u_nodes)
         else:
             G = inner.G.copy()
             gaps = inner.evaluate(self.u.vector)
+            if pointwise:
+                gaps_plus, G_plus = inner.points.positive_gaps(self.u.vector)
         if isinstance(model, GlobalGap):
             gaps = model.mass.solve(gaps)                                  # d̄ = L⁻¹ ĝ
-            force = model.mass.solve(model.weights * np.maximum(gaps, 0.0))  # z = L⁻¹ ω⟨d̄⟩
+            if pointwise:
+                gaps_plus = model.mass.solve(gaps_plus)                    # d̄⁺ = L⁻¹ ĝ⁺
+                force = model.mass.solve(model.weights * gaps_plus)        # z = L⁻¹ ω d̄⁺
+            else:
+                force = model.mass.solve(model.weights * np.maximum(gaps, 0.0))
         else:
-            force = model.weights * np.maximum(gaps, 0.0)
+            force = model.weights * (gaps_plus if pointwise else np.maximum(gaps, 0.0))
         G.diagonalScale(None, self._mask())
+        if G_plus is not None:
+            G_plus.diagonalScale(None, self._mask())
         K_curv = None
         if x is not None:
             blocks = inner.curvature_blocks(force, x)
             if blocks is not None:
-                from dolfinx_mortar.layout import assemble_blocks
                 nc, nd = self.slave.cells.shape
                 width = nd * self.slave.gdim
                 dofs = inner._node_dofs(self.slave.cells).reshape(nc, width)
@@ -294,7 +326,7 @@ class ContactProblem:
                          + np.arange(self.slave.gdim)).reshape(nc, width)
                 K_curv = assemble_blocks(inner.dofs, local, inner.dofs, dofs, blocks)
                 K_curv.diagonalScale(self._mask(), self._mask())
-        return gaps, G, force, K_curv
+        return ContactState(gaps, G, force, K_curv, gaps_plus, G_plus)
 
     # -- SNES callbacks --------------------------------------------------------------
     def _residual(self, snes, x: PETSc.Vec, b: PETSc.Vec) -> None:
@@ -308,10 +340,9 @@ class ContactProblem:
         b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         self._add("bulk_residual", clock)
         clock = time.perf_counter()
-        gaps, G, force, K_curv = self._contact()
-        self._state = (gaps, G, force, K_curv)
-        Rc = G.createVecRight()
-        G.multTranspose(self.slave.layout.vector(force), Rc)
+        state = self._state = self._contact()
+        Rc = state.G.createVecRight()
+        state.G.multTranspose(self.slave.layout.vector(state.force), Rc)
         b.axpy(1.0, Rc)
         self._add("contact_residual", clock)
         fem_petsc.set_bc(b, self.bcs, x, -1.0)
@@ -323,16 +354,22 @@ class ContactProblem:
         self.A_bulk.assemble()
         self._add("bulk_jacobian", clock)
         clock = time.perf_counter()
-        gaps, G, force, K_curv = self._state
-        weights = self.gap_model.weights * self._active(gaps)
+        state = self._state
+        G, K_curv = state.G, state.K_curv
+        G_right = G
+        if state.gaps_plus is not None and self._any_penetration(state.gaps_plus):
+            weights = self.gap_model.weights
+            G_right = state.G_plus
+        else:
+            weights = self.gap_model.weights * self._active(state.gaps)
         if isinstance(self.gap_model, GlobalGap):
             K = self.A_bulk.copy()
             if K_curv is not None:
                 K.axpy(1.0, K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            self._augmented.update(K, G, weights, self.gap_model.mass.matrix)
+            self._augmented.update(K, G, weights, self.gap_model.mass.matrix, G_right)
             self._add("contact_jacobian", clock)
             return
-        SG = G.copy()
+        SG = G_right.copy()
         SG.diagonalScale(self.slave.layout.vector(weights), None)
         Kc = G.transposeMatMult(SG)
         J.zeroEntries()
@@ -342,6 +379,11 @@ class ContactProblem:
             J.axpy(1.0, K_curv, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         J.assemble()
         self._add("contact_jacobian", clock)
+
+    def _any_penetration(self, gaps_plus: FloatArray) -> bool:
+        """Whether d̄⁺ ≠ 0 anywhere: else G⁺ = 0 and the nodal fallback stiffens."""
+        n = self.slave.layout.num_owned
+        return bool(self.mesh.comm.allreduce(bool(np.any(gaps_plus[:n] != 0))))
 
     def _active(self, gaps: FloatArray) -> FloatArray:
         """Nodes that get contact stiffness in the Jacobian (H(d̄) as 0/1).
@@ -365,6 +407,43 @@ class ContactProblem:
             active = covered & (gaps >= -0.1 * length)
         return active.astype(np.float64)
 
+    def _close_gaps(self, snes: PETSc.SNES, x: PETSc.Vec) -> None:
+        """Move x into contact when nothing touches yet (a better Newton start).
+
+        With positive mortar functions a body that touches at a point has
+        d̄ < 0 at every node, no contact force, and Newton's linear model —
+        stiff only from the current gap on — creeps towards the obstacle by
+        F/(εA) per iteration. This step solves the linear model in which the
+        nodes near contact (:meth:`_active`) carry the force ``ω(d̄ + GΔu)``,
+        which closes the gap. It changes only where Newton starts, not the
+        solution. GLS kinds skip it (their d̄ = L⁻¹ĝ changes sign anyway).
+        """
+        if isinstance(self.gap_model, GlobalGap):
+            return
+        self._residual(None, x, self.b)
+        state = self._state
+        n = self.slave.layout.num_owned
+        touching = (state.gaps_plus if state.gaps_plus is not None
+                    else np.where(self.gap_model.covered, np.maximum(state.gaps, 0.0), 0.0))
+        if self.mesh.comm.allreduce(bool(np.any(touching[:n] != 0))):
+            return
+        near = self._active(state.gaps)
+        if self.mesh.comm.allreduce(int(np.sum(near[:n]))) == 0:
+            return
+        J = self._total_matrix()
+        self._jacobian(snes, x, J, J)
+        rhs = self.b.copy()
+        pull = state.G.createVecRight()
+        state.G.multTranspose(self.slave.layout.vector(self.gap_model.weights * near
+                                                       * state.gaps), pull)
+        rhs.axpy(1.0, pull)
+        ksp = snes.getKSP()
+        ksp.setOperators(J)
+        dx = rhs.duplicate()
+        ksp.solve(rhs, dx)
+        if ksp.getConvergedReason() > 0:
+            x.axpy(-1.0, dx)
+
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
 
@@ -376,7 +455,7 @@ class ContactProblem:
         """
         if self._A_total is None:
             self._residual(None, self.u.vector, self.b)
-            gaps, G, force, K_curv = self._state
+            G, K_curv = self._state.G, self._state.K_curv
             A = self.A_bulk.duplicate(copy=False)
             fem_petsc.assemble_matrix(A, self.J_form, self.bcs)
             A.assemble()
@@ -426,7 +505,9 @@ class ContactProblem:
         A step whose Newton solve fails is halved and retried, at most
         ``max_cuts`` times in a row; then :class:`ContactDivergenceError` is
         raised with the residual history. Each converged step is written to
-        ``output`` (XDMF) before the next one starts.
+        ``output`` (XDMF: displacement and ``p̂`` on the mesh) and to
+        ``<output stem>_slave.xdmf`` (``p̂`` and ``p*`` on the slave facets, one
+        set of nodes per facet since ``p*`` may jump) before the next one starts.
         """
         if load_steps < 1:
             raise ValueError("load_steps must be at least 1")
@@ -449,6 +530,7 @@ class ContactProblem:
             saved = self.u.vector.copy()
             clock = time.perf_counter()
             x = self.u.vector.copy()
+            self._close_gaps(snes, x)
             snes.setConvergenceHistory(reset=True)
             snes.solve(None, x)
             reason = snes.getConvergedReason()
@@ -466,8 +548,9 @@ class ContactProblem:
             x.copy(self.u.vector)
             self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT,
                                       mode=PETSc.ScatterMode.FORWARD)
-            gaps = self.nodal_gaps()
-            active = self.mesh.comm.allreduce(int(np.sum(gaps[: self.slave.layout.num_owned] > 0)))
+            pressures = self.nodal_pressures()
+            active = self.mesh.comm.allreduce(
+                int(np.sum(pressures[: self.slave.layout.num_owned] > 0)))
             s = StepResult(target, snes.getIterationNumber(), history,
                            time.perf_counter() - clock, active)
             result.steps.append(s)
@@ -490,11 +573,35 @@ class ContactProblem:
     # -- results ---------------------------------------------------------------------
     def nodal_gaps(self) -> FloatArray:
         """``d̄_A`` at the local slave-layout nodes for the current u."""
-        return self._contact()[0]
+        return self._contact().gaps
 
     def nodal_pressures(self) -> FloatArray:
-        """Contact pressure ``p_A = ε⟨d̄_A⟩`` (consistent scaling) at local nodes."""
-        return self.gap_model.nodal_pressures(self.nodal_gaps())
+        """Contact pressure at local nodes: ``p_A = ε⟨d̄_A⟩`` (nodal active set) or
+        ``ε d̄⁺_A`` (pointwise), consistent scaling."""
+        state = self._contact()
+        if state.gaps_plus is not None:
+            return self.gap_model.nodal_pressures(state.gaps_plus, positive_part=False)
+        return self.gap_model.nodal_pressures(state.gaps)
+
+    def mortar_traction(self) -> FloatArray:
+        """The contact traction ``p* = Σ_A f_A M_A`` at the nodes of every slave cell.
+
+        ``f_A = ω_A⟨d̄_A⟩`` (or ``ω_A d̄⁺_A``) and ``M`` the gap basis, so that
+        the contact virtual work is ``∫ p* δd``; (cells, nodes) values, one set
+        per cell because ``p*`` of the dual kinds jumps between cells.
+        """
+        state = self._contact()
+        cells = self.slave.cells
+        if isinstance(self.gap_model, GlobalGap):   # Σ_A f_A (N L⁻¹)_A = Σ_B N_B z_B
+            return state.force[cells]
+        # M_A at node b of cell c is C[c, b, A]: N_std is 1 at its own node
+        return np.einsum("cba,ca->cb", self.gap_model.coefficients_std, state.force[cells])
+
+    def contact_force(self) -> float:
+        """Total normal contact force ``∫ p* dA = Σ_A W_A p_A`` over all ranks."""
+        n = self.slave.layout.num_owned
+        W = self.gap_model.basis.lumped_weights
+        return float(self.mesh.comm.allreduce(float(np.sum((W * self.nodal_pressures())[:n]))))
 
     def _open_output(self, path: Path) -> None:
         if path.suffix != ".xdmf":
@@ -503,6 +610,7 @@ class ContactProblem:
         self._output = path
         with io.XDMFFile(self.mesh.comm, str(path), "w") as f:
             f.write_mesh(self.mesh)
+        self._surface_output = SlaveSurfaceOutput(self.slave, surface_output_path(path))
 
     def _write_step(self, t: float) -> None:
         """Append the step, reopening the file so that it is complete on disk."""
@@ -510,6 +618,9 @@ class ContactProblem:
         with io.XDMFFile(self.mesh.comm, str(self._output), "a") as f:
             f.write_function(u1, t)
             f.write_function(p_hat, t)
+        cells = self.slave.cells
+        self._surface_output.write({"p_hat": self.nodal_pressures()[cells],
+                                    "p_star": self.mortar_traction()}, t)
 
     def _output_functions(self) -> tuple[fem.Function, fem.Function]:
         mesh = self.mesh
@@ -550,7 +661,11 @@ class AugmentedNewtonStep:
         self.prefix = prefix
         self.ksp: Optional[PETSc.KSP] = None
 
-    def update(self, K: PETSc.Mat, G: PETSc.Mat, weights: FloatArray, L: PETSc.Mat) -> None:
+    def update(self, K: PETSc.Mat, G: PETSc.Mat, weights: FloatArray, L: PETSc.Mat,
+               G_linearized: Optional[PETSc.Mat] = None) -> None:
+        """Assemble and factorize; ``G_linearized`` replaces Ĝ in the last row
+        (the pointwise active set's Ĝ⁺, with ``weights`` = ω)."""
+        G_last = G if G_linearized is None else G_linearized
         layout_vec = L.createVecLeft()
         layout_vec.array[:] = weights[: layout_vec.getLocalSize()]
         S = PETSc.Mat().createAIJ(L.getSizes(), nnz=(1, 0), comm=L.comm)
@@ -559,7 +674,8 @@ class AugmentedNewtonStep:
         minus_L = L.copy()
         minus_L.scale(-1.0)
         GT = G.copy().transpose()
-        nest = PETSc.Mat().createNest([[K, None, GT], [None, S, minus_L], [G, minus_L, None]],
+        nest = PETSc.Mat().createNest([[K, None, GT], [None, S, minus_L],
+                                       [G_last, minus_L, None]],
                                       comm=self.comm)
         self.index_sets = nest.getNestISs()[0]
         A = nest.convert("aij")

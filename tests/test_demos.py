@@ -51,3 +51,23 @@ def test_fig2_sphere_reproduces_the_papers_statements(out):
                     > 10 * rows[(n, pu)]["max_mortar_over_max_raw"])
     for k in ("GLS", "LmLS", "LcLS"):                           # refinement helps
         assert rows[(16, k)]["l2_error_smoothed"] < 0.6 * rows[(8, k)]["l2_error_smoothed"]
+
+
+def test_demo_command_lines_pass_petsc_options_to_the_database():
+    import argparse
+
+    from petsc4py import PETSc
+
+    from dolfinx_mortar.cli import parse_args_and_petsc_options
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--refine", type=float, default=1.0)
+    args = parse_args_and_petsc_options(parser, ["--refine", "2", "-cli_test_snes_monitor",
+                                                 "-cli_test_snes_rtol", "1e-3"])
+    options = PETSc.Options()
+    assert args.refine == 2.0
+    assert options.hasName("cli_test_snes_monitor")
+    assert options.getReal("cli_test_snes_rtol") == 1e-3
+    options.delValue("cli_test_snes_monitor")
+    options.delValue("cli_test_snes_rtol")
+    with pytest.raises(SystemExit):
+        parse_args_and_petsc_options(parser, ["--bogus"])

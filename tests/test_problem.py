@@ -184,6 +184,36 @@ def test_converged_steps_are_written_to_xdmf(tmp_path_factory):
         text = (Path(path) / "block.xdmf").read_text()
         assert text.count('Name="displacement"') >= 3 and "contact_pressure" in text
         assert (Path(path) / "block.h5").stat().st_size > 0
+        surface = (Path(path) / "block_slave.xdmf").read_text()
+        assert surface.count("/Function/p_star/") == 3 and surface.count("/Function/p_hat/") == 3
+
+
+@pytest.mark.parametrize("kind", ALL_KINDS)
+def test_mortar_traction_on_the_slave_surface_mesh(kind, tmp_path_factory):
+    """p* is the traction: it equals the applied pressure on a block on a plane,
+    integrates to the contact force, and the broken surface mesh carries it
+    node by node."""
+    from dolfinx_mortar.surface_output import SlaveSurfaceOutput
+    V, tags = block_on_plane(n=(9, 3))
+    problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
+                             kind=kind, penalty=1e4, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    problem.solve(load_steps=1)
+    p_star = problem.mortar_traction()
+    assert np.max(np.abs(p_star / 0.01 - 1), initial=0) < 1e-9
+    comm = problem.mesh.comm
+    path = comm.bcast(str(tmp_path_factory.mktemp("surface") / "slave.xdmf")
+                      if comm.rank == 0 else None)
+    out = SlaveSurfaceOutput(problem.slave, Path(path))
+    f = out.function("p_star", p_star)
+    coordinates = out.space.tabulate_dof_coordinates()[:, :2]
+    slave = problem.slave
+    expected = slave.x[slave.cells][out.source]          # (cells, nd, gdim)
+    assert np.allclose(coordinates[out.dofs], expected, atol=1e-14)
+    assert np.allclose(f.x.array[out.dofs], p_star[out.source])
+    tab = slave.tabulate(4, transformed=False)
+    total = comm.allreduce(float(np.einsum("cq,cqb,cb->", tab.weights, tab.phi, p_star)))
+    assert total == pytest.approx(problem.contact_force(), rel=1e-10)
 
 
 def test_bad_input_is_reported():
@@ -352,3 +382,15 @@ def test_hertz3d_two_elastic_bodies_from_a_mesh_file(tmp_path_factory):
                                       "--load-displacement", "0.002",
                                       "--h-contact", str(builtin["h_contact"])]), comm)
     assert moved["contact_force"] > 0 and abs(moved["p0_error"]) < 0.15, moved
+
+
+def test_first_touch_with_positive_mortar_functions_converges():
+    """A sphere touching a plane at one point with LmLS*: every d̄_A < 0 at the start.
+
+    Without the gap-closing start (ContactProblem._close_gaps) Newton crept
+    towards the plane by F/(εA) per iteration and failed after every cut-back.
+    """
+    figures = load("hertz3d").main(["--kind", "LmLS*", "--refine", "0.7"])
+    assert figures["contact_force"] == pytest.approx(figures["force"], rel=1e-8)
+    assert figures["load_steps"] == 3   # no cut-back
+    assert figures["newton_iterations"] <= 20

@@ -255,11 +255,14 @@ PYBIND11_MODULE(_kernels, m)
        const array_t& points,
        const array_t& weights,
        bool opposing_normals_only,
-       double relative_tolerance)
+       double relative_tolerance,
+       bool keep_points)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
-      SegmentationOptions options{ opposing_normals_only, relative_tolerance };
+      SegmentationOptions options{ opposing_normals_only,
+                                   relative_tolerance,
+                                   keep_points };
       MortarIntegrals r;
       {
         py::gil_scoped_release release;
@@ -281,6 +284,17 @@ PYBIND11_MODULE(_kernels, m)
       out["gap"] = to_numpy(r.gap, { np, ns });
       out["area"] = to_numpy(r.area, { np });
       out["failed_projections"] = r.failed_projections;
+      if (keep_points)
+      {
+        const auto nq = static_cast<py::ssize_t>(r.point_pairs.size());
+        const py::ssize_t gdim = xs.shape(1);
+        out["point_pairs"] = to_numpy_as<std::int32_t>(r.point_pairs, { nq });
+        out["point_weights"] = to_numpy(r.point_weights, { nq });
+        out["point_gap"] = to_numpy(r.point_gap, { nq });
+        out["point_normals"] = to_numpy(r.point_normals, { nq, gdim });
+        out["point_slave_N"] = to_numpy(r.point_slave_N, { nq, ns });
+        out["point_master_N"] = to_numpy(r.point_master_N, { nq, nm });
+      }
       return out;
     },
     py::arg("slave_type"),
@@ -295,5 +309,6 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("weights"),
     py::arg("opposing_normals_only") = true,
     py::arg("relative_tolerance") = 1e-12,
+    py::arg("keep_points") = false,
     "Segmentation and slave-basis mortar integrals per cell pair");
 }

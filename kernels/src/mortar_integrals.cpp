@@ -305,8 +305,36 @@ mortar_integrals(const FacetSurface& slave,
             const Point3 gap_vector = sub(xs, xm);
             const double d = n_norm > 0 ? dot(gap_vector, n) / n_norm : 0.0;
             acc.add(weights[q] * cell.measure, Ns, Nm, d);
+            if (options.keep_points)
+            {
+              // the pair index is the number of pairs stored so far
+              out.point_pairs.push_back(
+                static_cast<std::int32_t>(out.area.size()));
+              out.point_weights.push_back(weights[q] * cell.measure);
+              out.point_gap.push_back(d);
+              for (int k = 0; k < gdim; ++k)
+                out.point_normals.push_back(n_norm > 0 ? n[k] / n_norm : 0.0);
+              out.point_slave_N.insert(
+                out.point_slave_N.end(), Ns.begin(), Ns.end());
+              out.point_master_N.insert(
+                out.point_master_N.end(), Nm.begin(), Nm.end());
+            }
           }
       }
+    }
+    if (acc.area <= 0 and options.keep_points)
+    {
+      // drop the points of a pair that is not kept
+      const auto first = std::find(out.point_pairs.begin(),
+                                   out.point_pairs.end(),
+                                   static_cast<std::int32_t>(out.area.size()));
+      const auto n = static_cast<std::size_t>(out.point_pairs.end() - first);
+      out.point_pairs.resize(out.point_pairs.size() - n);
+      out.point_weights.resize(out.point_weights.size() - n);
+      out.point_gap.resize(out.point_gap.size() - n);
+      out.point_normals.resize(out.point_normals.size() - n * gdim);
+      out.point_slave_N.resize(out.point_slave_N.size() - n * ns);
+      out.point_master_N.resize(out.point_master_N.size() - n * nm);
     }
     if (acc.area > 0)
     {

@@ -23,6 +23,15 @@ struct MortarIntegrals
   std::vector<double> gap;             ///< (pairs, ns): ∫ N_A d
   std::vector<double> area;            ///< (pairs): covered area
   std::int64_t failed_projections = 0; ///< Newton failures (points skipped)
+
+  /// Per quadrature point, only with SegmentationOptions::keep_points (the
+  /// pointwise active set needs ⟨d⟩ at every point, not only ∫N d).
+  std::vector<std::int32_t> point_pairs; ///< (points): index into pairs
+  std::vector<double> point_weights;     ///< (points): weight × area factor
+  std::vector<double> point_gap;         ///< (points): d
+  std::vector<double> point_normals;     ///< (points, gdim): unit n
+  std::vector<double> point_slave_N;     ///< (points, ns): N_A
+  std::vector<double> point_master_N;    ///< (points, nm): N^m_C∘χ
 };
 
 /// Options of the segmentation.
@@ -32,6 +41,8 @@ struct SegmentationOptions
   bool opposing_normals_only = true;
   /// Overlaps smaller than this fraction of the slave sub-facet are dropped.
   double relative_tolerance = 1e-12;
+  /// Also return the data of every quadrature point (MortarIntegrals::point_*).
+  bool keep_points = false;
 };
 
 /// Segment candidate slave–master cell pairs and integrate on the segments.

@@ -1,0 +1,36 @@
+"""Command lines of the demos and benchmarks: their own options plus PETSc's.
+
+``hertz2d.py --refine 2 -dolfinx_mortar_snes_monitor`` should work as a PETSc
+user expects: arguments with a single leading dash go to the PETSc options
+database (an option followed by a value that does not start with a dash takes
+that value), everything else to argparse.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Optional, Sequence
+
+
+def parse_args_and_petsc_options(parser: argparse.ArgumentParser,
+                                 argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
+    """Parse ``argv`` (default ``sys.argv[1:]``); put PETSc options in the database.
+
+    Raises the parser's usage error for unknown ``--options``.
+    """
+    args, rest = parser.parse_known_args(sys.argv[1:] if argv is None else list(argv))
+    options = {}
+    i = 0
+    while i < len(rest):
+        item = rest[i]
+        if not item.startswith("-") or item.startswith("--") or len(item) < 2:
+            parser.error(f"unrecognized argument: {item}")
+        has_value = i + 1 < len(rest) and not rest[i + 1].startswith("-")
+        options[item[1:]] = rest[i + 1] if has_value else ""
+        i += 2 if has_value else 1
+    if options:
+        from petsc4py import PETSc
+        database = PETSc.Options()
+        for key, value in options.items():
+            database[key] = value
+    return args

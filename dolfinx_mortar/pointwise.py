@@ -1,0 +1,164 @@
+"""The pointwise active set: ``d̄⁺_A = ∫ M̄_A ⟨d⟩`` and its derivative (DESIGN.md §3).
+
+With the nodal active set the penalty acts on ``⟨d̄_A⟩``; with the pointwise
+one the nodal pressure is ``p_A = ε d̄⁺_A``, integrated only where the slave
+penetrates (the seed's ``p_A = ∫ M_A ε⟨d⟩``). The contact virtual work stays
+``Σ_A ω_A d̄⁺_A δd̄_A``, so the residual is ``Gᵀ(ω d̄⁺)`` and the Jacobian
+``Gᵀ diag(ω) G⁺`` (plus curvature), with ``G⁺ = ∂d̄⁺/∂u`` — unsymmetric, which
+MUMPS' LU takes as it is. Moving the boundary of {d > 0} adds nothing to
+``G⁺`` because the integrand vanishes there.
+
+- Rigid obstacle: cells that the contact boundary cuts are split at d = 0
+  (:mod:`dolfinx_mortar.cut_quadrature`); uncut cells keep their Gauss rule, so
+  a fully penetrating surface gives the nodal result to round-off.
+- Elastic master: ⟨d⟩ at the segment quadrature points; segments are not
+  split (the kink costs quadrature accuracy on the few cut segments only).
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+from petsc4py import PETSc
+
+from dolfinx_mortar.cut_quadrature import positive_part_rule
+from dolfinx_mortar.lagrange import _measure_from_tangents
+from dolfinx_mortar.layout import NodeLayout, assemble_blocks
+
+if TYPE_CHECKING:
+    from dolfinx_mortar.contact_terms import MortarGap, ObstacleGap
+
+FloatArray = npt.NDArray[np.float64]
+
+#: sub-pieces per reference edge of a cut cell (see cut_quadrature)
+CUT_SUBDIVISIONS = 8
+
+
+def _assemble_gap_derivative(model, row_cells: npt.NDArray[np.int64],
+                             cols: npt.NDArray[np.int64], blocks: FloatArray) -> PETSc.Mat:
+    nb = len(row_cells)
+    nd = model.slave.cells.shape[1]
+    width = cols.shape[1] if nb else nd * model.slave.gdim
+    return assemble_blocks(model.slave.layout, row_cells.reshape(nb, nd), model.dofs,
+                           cols.reshape(nb, width), blocks.reshape(nb, nd, width))
+
+
+def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray
+                           ) -> tuple[FloatArray, PETSc.Mat]:
+    """``d̄⁺`` at the local slave nodes and ``G⁺`` against a rigid obstacle.
+
+    ``u_nodes``: displacement at the local slave-layout nodes, (nodes, gdim).
+    """
+    slave, tab = model.slave, model.tabulation
+    cells, gdim = slave.cells, slave.gdim
+    if model.reference is not None:
+        u_nodes = u_nodes - model.reference
+    nc, nq, nd = tab.phi.shape
+    x_nodes = slave.x + u_nodes                       # current nodal positions
+    xq = np.einsum("cqb,cbk->cqk", tab.phi, x_nodes[cells] - slave.x[cells]) + tab.points
+    d = -model.obstacle.signed_distance(xq.reshape(-1, gdim)).reshape(nc, nq)
+    d_nodes = -model.obstacle.signed_distance(x_nodes[cells].reshape(-1, gdim)).reshape(nc, nd)
+    samples = np.concatenate([d, d_nodes], axis=1)
+    full = np.all(samples > 0, axis=1)
+    mixed = np.flatnonzero(np.any(samples > 0, axis=1) & ~full)
+
+    # fully penetrating cells: the Gauss rule, as for the nodal gaps
+    f = np.flatnonzero(full)
+    nu = model.obstacle.gradient(xq[f].reshape(-1, gdim)).reshape(len(f), nq, gdim)
+    wd = tab.weights[f] * d[f]
+    values = [np.einsum("cqa,cq->ca", model.Mbar[f], wd)]
+    rows = [cells[f]]
+    blocks = [-np.einsum("cq,cqa,cqk,cqb->cabk", tab.weights[f], model.Mbar[f], nu,
+                         tab.phi[f])]
+
+    # cut cells: a rule on their penetrating part
+    reference = slave.reference
+
+    def gap_at(c: npt.NDArray[np.int64], X: FloatArray) -> FloatArray:
+        N, _ = reference.tabulate(X, transformed=False)
+        return -model.obstacle.signed_distance(np.einsum("nb,nbk->nk", N, x_nodes[cells[c]]))
+
+    degree = 2 * reference.degree + 2
+    owner, X, w_ref, _ = positive_part_rule(reference.cell, mixed, gap_at, degree,
+                                            subdivisions=CUT_SUBDIVISIONS)
+    c = mixed[owner]
+    N, dN = reference.tabulate(X, transformed=False)
+    coords = slave.x[cells[c]]
+    tangents = [np.einsum("nb,nbk->nk", dN[:, t, :], coords) for t in range(slave.tdim)]
+    w = w_ref * _measure_from_tangents(tangents)
+    x = np.einsum("nb,nbk->nk", N, x_nodes[cells[c]])
+    dq = -model.obstacle.signed_distance(x)
+    # the rule covers {d > 0} up to the bisection tolerance: clip the rest
+    dq = np.maximum(dq, 0.0)
+    Mbar = np.einsum("nb,nba->na", N, model.coefficients_std[c])
+    values.append(Mbar * (w * dq)[:, None])
+    rows.append(cells[c])
+    blocks.append(-np.einsum("n,na,nk,nb->nabk", w, Mbar, model.obstacle.gradient(x), N))
+
+    row_cells = np.concatenate(rows)
+    gaps = slave.layout.sum_at_functions(row_cells, np.concatenate(values))
+    cols = model._node_dofs(row_cells).reshape(len(row_cells), nd * gdim)
+    G = _assemble_gap_derivative(model, row_cells, cols,
+                                 np.concatenate(blocks).reshape(len(row_cells), nd, nd * gdim))
+    return gaps, G
+
+
+class MortarPointGaps:
+    """``d̄⁺`` and ``G⁺`` against an elastic master, from the segment points.
+
+    Small deformation as in :class:`~dolfinx_mortar.contact_terms.MortarGap`:
+    ``d_q(u) = d_q⁰ + n_q·(Σ_B N_B Δu_B − Σ_C N^m_C Δu_C)`` at every segment
+    quadrature point q, ``Δu = u − reference``.
+    """
+
+    def __init__(self, model: "MortarGap"):
+        coupling = model.coupling
+        if coupling.points is None:
+            raise ValueError("the pointwise active set needs MortarCoupling(..., "
+                             "keep_points=True)")
+        self.model = model
+        pts = coupling.points
+        pair = pts["pairs"].astype(np.int64)
+        slave_cell = coupling.pairs[pair, 0]
+        master_cells = coupling.master_cells[coupling.pairs[pair, 1]]
+        self.rows = model.slave.cells[slave_cell]               # (points, ns)
+        self.d0 = pts["gap"]
+        n = pts["normals"]
+        bs = model.slave.gdim
+        Ns, Nm = pts["slave_N"], pts["master_N"]
+        npts = len(self.d0)
+        slave_dofs = model._node_dofs(self.rows)
+        master_dofs = (coupling.master_global_ids[master_cells][..., None] * bs
+                       + np.arange(bs))
+        width = (Ns.shape[1] + Nm.shape[1]) * bs
+        #: ∂d_q/∂u per point, and the global dofs it acts on
+        self.dd = np.concatenate([np.einsum("qb,qk->qbk", Ns, n),
+                                  -np.einsum("qc,qk->qck", Nm, n)], axis=1).reshape(npts, width)
+        self.cols = np.concatenate([slave_dofs, master_dofs], axis=1).reshape(npts, width)
+        #: w_q M̄_A(q)
+        self.wM = pts["weights"][:, None] * np.einsum(
+            "qb,qba->qa", Ns, model.coefficients_std[slave_cell])
+        points = NodeLayout(model.slave.layout.comm, npts, np.zeros(0, dtype=np.int64))
+        self.point_derivative = assemble_blocks(points, np.arange(npts)[:, None], model.dofs,
+                                                self.cols, self.dd[:, None, :])
+
+    def point_gaps(self, u: PETSc.Vec) -> FloatArray:
+        """d at every local segment point for the displacement vector u."""
+        reference = self.model.reference
+        if reference is not None:
+            u = u.copy()
+            u.axpy(-1.0, reference)
+        d = self.point_derivative.createVecLeft()
+        self.point_derivative.mult(u, d)
+        return self.d0 + d.array_r
+
+    def positive_gaps(self, u: PETSc.Vec) -> tuple[FloatArray, PETSc.Mat]:
+        """``d̄⁺`` at the local slave nodes and ``G⁺`` for the displacement u."""
+        d = self.point_gaps(u)
+        active = d > 0
+        layout = self.model.slave.layout
+        gaps = layout.sum_at_functions(self.rows, self.wM * np.maximum(d, 0.0)[:, None])
+        a = np.flatnonzero(active)
+        blocks = np.einsum("qa,qw->qaw", self.wM[a], self.dd[a])
+        return gaps, _assemble_gap_derivative(self.model, self.rows[a], self.cols[a], blocks)

@@ -1,0 +1,82 @@
+"""Fields on the slave surface for XDMF output: ``p̂`` and the mortar traction ``p*``.
+
+``p*`` of the dual kinds is discontinuous across slave facets, and DOLFINx
+0.5.2's XDMF writer only takes Lagrange data of the mesh's own degree. So the
+slave facets become a *broken* surface mesh — every facet with its own copies
+of its nodes — on which a continuous Lagrange function of the facet degree
+holds any element-wise field exactly. Every rank keeps its own facets (a
+partitioner that moves nothing), so no data travels.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+import ufl
+from dolfinx import cpp, fem, io
+from dolfinx import mesh as dmesh
+
+from dolfinx_mortar.lagrange import LagrangeSurface
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def surface_output_path(path: Path) -> Path:
+    """The slave-surface file next to a bulk output file: ``run.xdmf`` → ``run_slave.xdmf``."""
+    path = Path(path)
+    return path.with_name(path.stem + "_slave" + path.suffix)
+
+
+class SlaveSurfaceOutput:
+    """Writes element-wise nodal fields of a slave surface to an XDMF file.
+
+    Parameters
+    ----------
+    slave
+        The slave surface (this rank's facets).
+    path
+        The ``.xdmf`` file; it is created with the surface mesh.
+    """
+
+    def __init__(self, slave: LagrangeSurface, path: Path):
+        comm = slave.layout.comm
+        self.path = Path(path)
+        self.slave = slave
+        nc, nd = slave.cells.shape
+        gdim = slave.gdim
+        offset = comm.scan(nc) - nc
+        x = slave.x[slave.cells].reshape(nc * nd, gdim)
+        cells = (offset + np.arange(nc, dtype=np.int64))[:, None] * nd + np.arange(nd)
+        rank = comm.rank
+
+        def keep_on_this_rank(_comm, _nparts, _tdim, graph, _ghost_mode):
+            return cpp.graph.AdjacencyList_int32(np.full(graph.num_nodes, rank, dtype=np.int32))
+
+        cell = ufl.Cell(slave.reference.cell, geometric_dimension=gdim)
+        domain = ufl.Mesh(ufl.VectorElement("Lagrange", cell, slave.reference.degree, dim=gdim))
+        self.mesh = dmesh.create_mesh(comm, cells, x, domain, ghost_mode=dmesh.GhostMode.none,
+                                      partitioner=keep_on_this_rank)
+        self.mesh.name = "slave_surface"
+        self.space = fem.FunctionSpace(self.mesh, ("Lagrange", slave.reference.degree))
+        num_local = self.mesh.topology.index_map(self.mesh.topology.dim).size_local
+        original = np.asarray(self.mesh.topology.original_cell_index[:num_local])
+        #: slave cell of every surface-mesh cell, and the dofs of its nodes
+        self.source = original - offset
+        self.dofs = self.space.dofmap.list.array.reshape(-1, nd)[:num_local]
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        with io.XDMFFile(comm, str(self.path), "w") as f:
+            f.write_mesh(self.mesh)
+
+    def function(self, name: str, values: FloatArray) -> fem.Function:
+        """A function from values at every node of every slave cell, (cells, nd)."""
+        u = fem.Function(self.space, name=name)
+        u.x.array[self.dofs] = np.asarray(values)[self.source]
+        return u
+
+    def write(self, fields: dict[str, FloatArray], t: float) -> None:
+        """Append fields (name → (cells, nd) values) at time t; the file stays
+        complete on disk after every call."""
+        with io.XDMFFile(self.slave.layout.comm, str(self.path), "a") as f:
+            for name, values in fields.items():
+                f.write_function(self.function(name, values), t)
