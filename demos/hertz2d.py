@@ -46,6 +46,9 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--scaling", default="consistent", choices=("consistent", "seed"))
     parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
                         help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
+    parser.add_argument("--basis-configuration", default="initial",
+                        choices=("initial", "previous", "current"),
+                        help="configuration of the bases: initial, previous step, current")
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"))
@@ -166,6 +169,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
     problem = ContactProblem(V, facet_tags, SLAVE, E=args.E, nu=args.nu, kind=args.kind,
                              penalty=args.penalty * args.E / h_contact, scaling=args.scaling,
                              active_set=args.active_set,
+                             basis_configuration=args.basis_configuration,
                              fixed=fixed,
                              tractions={LOAD: [0.0, -args.force / (2 * args.radius)]},
                              **kwargs)
@@ -182,6 +186,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
         "load_steps": len(result.steps), "wall_time": wall, "h_contact": h_contact,
         "kind": args.kind, "scaling": args.scaling, "obstacle": args.obstacle,
         "active_set": args.active_set,
+        "basis_configuration": args.basis_configuration,
         "degree": args.degree, "refine": args.refine, "ranks": comm.size,
     })
     if comm.rank == 0:

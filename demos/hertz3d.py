@@ -54,6 +54,9 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
     parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
                         help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
+    parser.add_argument("--basis-configuration", default="initial",
+                        choices=("initial", "previous", "current"),
+                        help="configuration of the bases: initial, previous step, current")
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"),
@@ -206,6 +209,7 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     problem = ContactProblem(V, facet_tags, names["slave"], E=args.E, nu=args.nu,
                              kind=args.kind, penalty=args.penalty * args.E / h_contact,
                              active_set=args.active_set,
+                             basis_configuration=args.basis_configuration,
                              fixed=fixed, tractions=tractions, **kwargs)
     result = problem.solve(load_steps=args.load_steps, output=args.output,
                            progress=comm.rank == 0)
@@ -219,6 +223,7 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
                     "h_contact": h_contact, "contact_force": contact_force, "force": force,
                     "kind": args.kind, "refine": args.refine, "ranks": comm.size,
                     "active_set": args.active_set,
+        "basis_configuration": args.basis_configuration,
                     "mesh": args.mesh})
     return figures
 

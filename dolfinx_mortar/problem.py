@@ -22,6 +22,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_kind
 from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
+from dolfinx_mortar.finite_deformation import CurrentObstacleGap, CurrentState
 from dolfinx_mortar.kinds import KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.mortar import MortarCoupling
 from dolfinx_mortar.layout import assemble_blocks
@@ -73,6 +74,8 @@ class ContactState:
     K_curv: Optional[PETSc.Mat]
     gaps_plus: Optional[FloatArray] = None
     G_plus: Optional[PETSc.Mat] = None
+    #: basis_configuration="current": the full residual and Jacobian data
+    current: Optional[CurrentState] = None
 
 
 class ContactDivergenceError(RuntimeError):
@@ -151,7 +154,9 @@ class ContactProblem:
         ``"initial"`` (default): bases and segmentation in the reference
         configuration; ``"previous"``: bases (and, for an elastic master, the
         segmentation) rebuilt in the last converged configuration after every
-        load step.
+        load step; ``"current"``: bases on the current surface at every Newton
+        iteration with the exact linearization (rigid obstacles, local kinds;
+        :mod:`dolfinx_mortar.finite_deformation`).
     fixed
         ``{tag: {component: value}}``: prescribed displacement components at
         load factor 1 (scaled by the load factor).
@@ -182,9 +187,13 @@ class ContactProblem:
         if basis_configuration not in CONFIGURATIONS:
             raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
                              f"expected {CONFIGURATIONS}")
-        if basis_configuration == "current":
-            raise NotImplementedError("basis_configuration='current' needs the finite-"
-                                      "deformation linearization; not implemented yet")
+        if basis_configuration == "current" and obstacle is None:
+            raise NotImplementedError(
+                "basis_configuration='current' with an elastic master needs the linearization "
+                "of the segmentation, which is not implemented; it works with rigid obstacles")
+        if basis_configuration == "current" and active_set == "pointwise":
+            raise NotImplementedError("basis_configuration='current' is implemented for the "
+                                      "nodal active set only")
         if obstacle is not None and obstacle.gdim != gdim:
             raise ValueError(f"a {obstacle.gdim}D obstacle in a {gdim}D mesh: the option "
                              "does not fit the mesh's dimension")
@@ -258,6 +267,12 @@ class ContactProblem:
     def _segment(self, u_nodes: Optional[FloatArray]) -> None:
         """(Re)build the gap model; for an elastic master in the configuration u."""
         clock = time.perf_counter()
+        if self.basis_configuration == "current":
+            self.gap_model = CurrentObstacleGap(self.slave, self.obstacle, self.kind,
+                                                self.penalty, self.scaling)
+            self._A_total, self._bc_mask, self._last_active = None, None, None
+            self.timings_segmentation = time.perf_counter() - clock
+            return
         if self.obstacle is not None:
             slave = self.slave if u_nodes is None else self.slave.moved(u_nodes)
             model = ObstacleGap(slave, self.obstacle, self.kind, self.penalty, self.scaling,
@@ -275,6 +290,7 @@ class ContactProblem:
                           if is_global(self.kind) else model)
         self._A_total: Optional[PETSc.Mat] = None
         self._bc_mask: Optional[PETSc.Vec] = None
+        self._last_active: Optional[FloatArray] = None
         self.timings_segmentation = time.perf_counter() - clock
 
     def _mask(self) -> PETSc.Vec:
@@ -289,6 +305,11 @@ class ContactProblem:
     def _contact(self) -> "ContactState":
         """Contact state at the current u (see :class:`ContactState`)."""
         model = self.gap_model
+        if isinstance(model, CurrentObstacleGap):
+            current = model.evaluate(nodal_displacement(self.slave, self.u), self._mask())
+            return ContactState(current.y, current.G_y,
+                                model.weights * np.maximum(current.y, 0.0), None,
+                                current=current)
         inner = model.inner if isinstance(model, GlobalGap) else model
         pointwise = self.active_set == "pointwise"
         x = None
@@ -341,8 +362,11 @@ class ContactProblem:
         self._add("bulk_residual", clock)
         clock = time.perf_counter()
         state = self._state = self._contact()
-        Rc = state.G.createVecRight()
-        state.G.multTranspose(self.slave.layout.vector(state.force), Rc)
+        if state.current is not None:
+            Rc = state.current.residual
+        else:
+            Rc = state.G.createVecRight()
+            state.G.multTranspose(self.slave.layout.vector(state.force), Rc)
         b.axpy(1.0, Rc)
         self._add("contact_residual", clock)
         fem_petsc.set_bc(b, self.bcs, x, -1.0)
@@ -355,6 +379,25 @@ class ContactProblem:
         self._add("bulk_jacobian", clock)
         clock = time.perf_counter()
         state = self._state
+        if state.current is not None:
+            # Far from the solution the pressure on the current surface can be
+            # many times its final value, and so its geometric stiffness:
+            # full Newton steps then cycled between active sets (Hertz 2D).
+            # While the active set moves, the frozen-surface part alone gives
+            # the step; once it settles, the exact Jacobian converges
+            # quadratically.
+            active = self._active(state.gaps)
+            settled = self.mesh.comm.allreduce(bool(
+                self._last_active is not None and np.array_equal(active, self._last_active)),
+                op=MPI.LAND)
+            self._last_active = active
+            Kc = self.gap_model.jacobian(state.current, active, self._mask(), geometric=settled)
+            J.zeroEntries()
+            J.axpy(1.0, self.A_bulk, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            J.axpy(1.0, Kc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            J.assemble()
+            self._add("contact_jacobian", clock)
+            return
         G, K_curv = state.G, state.K_curv
         G_right = G
         if state.gaps_plus is not None and self._any_penetration(state.gaps_plus):
@@ -396,6 +439,8 @@ class ContactProblem:
         the contact must hold makes the Jacobian singular. Once a node is
         active the Jacobian is exact again.
         """
+        if getattr(self, "_active_override", None) is not None:
+            return self._active_override
         # Nodes with no master below them have no gap (d̄ = 0 because nothing is
         # integrated there): they are never active.
         covered = self.gap_model.covered
@@ -414,9 +459,10 @@ class ContactProblem:
         d̄ < 0 at every node, no contact force, and Newton's linear model —
         stiff only from the current gap on — creeps towards the obstacle by
         F/(εA) per iteration. This step solves the linear model in which the
-        nodes near contact (:meth:`_active`) carry the force ``ω(d̄ + GΔu)``,
-        which closes the gap. It changes only where Newton starts, not the
-        solution. GLS kinds skip it (their d̄ = L⁻¹ĝ changes sign anyway).
+        closest nodes near contact (:meth:`_active`) carry the force
+        ``ω(d̄ + GΔu)``, which closes the gap there. It changes only where
+        Newton starts, not the solution. GLS kinds skip it (their d̄ = L⁻¹ĝ
+        changes sign anyway).
         """
         if isinstance(self.gap_model, GlobalGap):
             return
@@ -430,11 +476,23 @@ class ContactProblem:
         near = self._active(state.gaps)
         if self.mesh.comm.allreduce(int(np.sum(near[:n]))) == 0:
             return
+        # pull only the closest nodes to d̄ = 0: pulling every stiffened node
+        # shut would push the first touch as deep as the farthest one's gap
+        covered = self.gap_model.covered
+        closest = self.mesh.comm.allreduce(
+            float(np.max(state.gaps[:n][covered[:n]], initial=-np.inf)), op=MPI.MAX)
+        pulled = near * (state.gaps >= closest - 1e-6 * abs(closest))
         J = self._total_matrix()
-        self._jacobian(snes, x, J, J)
+        # only the pulled nodes are springs: stiff nodes that start at d̄ < 0
+        # would hold the body up and leave the pulled ones short of contact
+        self._active_override = pulled
+        try:
+            self._jacobian(snes, x, J, J)
+        finally:
+            self._active_override = None
         rhs = self.b.copy()
         pull = state.G.createVecRight()
-        state.G.multTranspose(self.slave.layout.vector(self.gap_model.weights * near
+        state.G.multTranspose(self.slave.layout.vector(self.gap_model.weights * pulled
                                                        * state.gaps), pull)
         rhs.axpy(1.0, pull)
         ksp = snes.getKSP()
@@ -459,7 +517,11 @@ class ContactProblem:
             A = self.A_bulk.duplicate(copy=False)
             fem_petsc.assemble_matrix(A, self.J_form, self.bcs)
             A.assemble()
-            if not isinstance(self.gap_model, GlobalGap):
+            if self._state.current is not None:
+                ones = np.ones(self.slave.layout.size_local)
+                Kc = self.gap_model.jacobian(self._state.current, ones, self._mask())
+                A.axpy(1.0, Kc, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            elif not isinstance(self.gap_model, GlobalGap):
                 Kc = G.transposeMatMult(G)
                 A.axpy(1.0, Kc, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
                 if K_curv is not None:
@@ -480,6 +542,13 @@ class ContactProblem:
         snes.setJacobian(self._jacobian, self._total_matrix())
         snes.setConvergenceHistory()
         snes.setFromOptions()
+        if (self.basis_configuration == "current"
+                and not PETSc.Options().hasName(prefix + "snes_linesearch_type")):
+            # On the current surface a pressure far above the final one (the first
+            # Newton steps of a contact problem overshoot) brings a geometric
+            # stiffness of its own size; full steps then cycled on Hertz 2D, the
+            # l2 line search converges (quadratically at the end).
+            snes.getLineSearch().setType("l2")
         if isinstance(self.gap_model, GlobalGap):
             # The Newton step is the exact solve of the augmented system; the
             # SNES's own KSP only applies it.
@@ -494,6 +563,44 @@ class ContactProblem:
         self.load.value = factor
         for c, value in self._bc_values:
             c.value = factor * value
+
+    def _newton(self, snes: PETSc.SNES, x: PETSc.Vec) -> tuple[int, list, int]:
+        """One load step's Newton solve from x: SNES reason, residuals, iterations.
+
+        With basis_configuration="current" the step is first solved with the
+        surface frozen where the step starts (the "previous" model: piecewise
+        linear, robust), then corrected on the current surface with the exact
+        Jacobian. Started from the current surface directly, the first
+        iterations overshoot to pressures whose geometric stiffness is larger
+        than the bulk's, and Newton cycled or diverged (Hertz 2D).
+        """
+        history: list = []
+        iterations = 0
+        current = self.gap_model if self.basis_configuration == "current" else None
+        phases = [None, current] if current is not None else [None]
+        for phase in phases:
+            if current is not None:
+                if phase is None:
+                    u_nodes = nodal_displacement(self.slave, self.u)
+                    self.gap_model = ObstacleGap(self.slave.moved(u_nodes), self.obstacle,
+                                                 self.kind, self.penalty, self.scaling,
+                                                 reference=u_nodes)
+                else:
+                    self.gap_model = current
+                    self._last_active = None
+            try:
+                self._close_gaps(snes, x)
+                snes.setConvergenceHistory(reset=True)
+                snes.solve(None, x)
+            finally:
+                if current is not None:
+                    self.gap_model = current
+            reason = snes.getConvergedReason()
+            history += list(snes.getConvergenceHistory()[0])
+            iterations += snes.getIterationNumber()
+            if reason <= 0:
+                break
+        return reason, history, iterations
 
     def solve(self, load_steps: int = 1, output: Optional[Union[str, Path]] = None,
               max_cuts: int = 5, progress: bool = False,
@@ -530,11 +637,7 @@ class ContactProblem:
             saved = self.u.vector.copy()
             clock = time.perf_counter()
             x = self.u.vector.copy()
-            self._close_gaps(snes, x)
-            snes.setConvergenceHistory(reset=True)
-            snes.solve(None, x)
-            reason = snes.getConvergedReason()
-            history = list(snes.getConvergenceHistory()[0])
+            reason, history, iterations = self._newton(snes, x)
             if reason <= 0:
                 failures.append((target, reason, history))
                 if len(failures) > max_cuts:
@@ -551,7 +654,7 @@ class ContactProblem:
             pressures = self.nodal_pressures()
             active = self.mesh.comm.allreduce(
                 int(np.sum(pressures[: self.slave.layout.num_owned] > 0)))
-            s = StepResult(target, snes.getIterationNumber(), history,
+            s = StepResult(target, iterations, history,
                            time.perf_counter() - clock, active)
             result.steps.append(s)
             reached = target
@@ -600,8 +703,10 @@ class ContactProblem:
     def contact_force(self) -> float:
         """Total normal contact force ``∫ p* dA = Σ_A W_A p_A`` over all ranks."""
         n = self.slave.layout.num_owned
-        W = self.gap_model.basis.lumped_weights
-        return float(self.mesh.comm.allreduce(float(np.sum((W * self.nodal_pressures())[:n]))))
+        p = self.nodal_pressures()
+        # the weights of the configuration the bases live in
+        W = getattr(self.gap_model, "current_weights", self.gap_model.basis.lumped_weights)
+        return float(self.mesh.comm.allreduce(float(np.sum((W * p)[:n]))))
 
     def _open_output(self, path: Path) -> None:
         if path.suffix != ".xdmf":

@@ -9,6 +9,7 @@ from mpi4py import MPI
 from dolfinx_mortar.cut_quadrature import positive_part_rule
 from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
+from jacobian_check import jacobian_error
 from test_problem import ALL_KINDS, block_on_plane, load
 
 
@@ -38,34 +39,6 @@ def test_cut_rule_converges_for_a_curved_zero_line():
     assert np.log2(errors[1] / errors[2]) > 1.8
 
 
-def _fd_error(problem, rng_seed=1):
-    """‖(R(x + h dx) − R(x − h dx))/2h − J dx‖ / ‖J dx‖ at the current u."""
-    x0 = problem.u.vector.copy()
-    J = problem._total_matrix()
-    b0 = problem.b.duplicate()
-    problem._residual(None, x0, b0)
-    problem._jacobian(None, x0, J, J)
-    dx = x0.duplicate()
-    dx.array[:] = np.random.default_rng(rng_seed + MPI.COMM_WORLD.rank).normal(
-        size=dx.array.shape)
-    fem.petsc.set_bc(dx, problem.bcs, scale=0.0)
-    Jdx = b0.duplicate()
-    J.mult(dx, Jdx)
-    h = 1e-6 / dx.norm()
-    residuals = []
-    for sign in (1, -1):
-        x = x0.copy()
-        x.axpy(sign * h, dx)
-        b = b0.duplicate()
-        problem._residual(None, x, b)
-        residuals.append(b)
-    fd = residuals[0].copy()
-    fd.axpy(-1.0, residuals[1])
-    fd.scale(1 / (2 * h))
-    fd.axpy(-1.0, Jdx)
-    return fd.norm() / Jdx.norm()
-
-
 @pytest.mark.parametrize("kind", ["LmLS*", "LmLS", "LcLS*"])
 @pytest.mark.parametrize("obstacle", ["plane", "sphere"])
 def test_pointwise_jacobian_matches_finite_differences_on_cut_cells(kind, obstacle):
@@ -83,7 +56,7 @@ def test_pointwise_jacobian_matches_finite_differences_on_cut_cells(kind, obstac
     positive = problem.mesh.comm.allreduce(int(np.sum(state.gaps_plus[:n] > 0)))
     negative = problem.mesh.comm.allreduce(int(np.sum(state.gaps[:n] < 0)))
     assert positive > 0 and negative > 0   # partly in contact
-    assert _fd_error(problem) < 1e-7
+    assert jacobian_error(problem) < 1e-7
 
 
 def test_pointwise_jacobian_matches_finite_differences_elastic_master():
@@ -105,7 +78,7 @@ def test_pointwise_jacobian_matches_finite_differences_elastic_master():
     n = problem.slave.layout.num_owned
     assert problem.mesh.comm.allreduce(int(np.sum(state.gaps_plus[:n] > 0))) > 0
     assert problem.mesh.comm.allreduce(int(np.sum(state.gaps[:n] < 0))) > 0
-    assert _fd_error(problem) < 1e-7
+    assert jacobian_error(problem) < 1e-7
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -1,0 +1,275 @@
+"""Contact against a rigid obstacle with the bases in the current configuration.
+
+``basis_configuration="current"`` (DESIGN.md §3, finite deformation): the slave
+surface, its area element, its lumped weights W and therefore its mortar
+functions follow the displacement u; the gap ``d = −φ(x + u)`` is exact. For
+the local kinds every nodal gap is ``y_A = ĝ_A W_A^{−k}`` with
+``ĝ_A = ∫ (N C)_A d da`` and ``W_A = ∫ N_A da`` on the current surface, and
+
+    Π_c(u) = Σ_A (ε/2) W_A^m ⟨y_A⟩²
+
+(consistent scaling: k = m = 1; seed scaling: k = 0 for the starred kinds,
+k = 1 for the others, m = 0). C is the identity for LmLS/LmLS* and
+``L_ref⁻¹ diag(W_ref)`` for the dual kinds — exact on affine facets only, so
+the dual kinds need P1 lines or triangles here. The residual is ∂Π/∂u and
+the Jacobian its exact second derivative, including the variation of the
+area element (``∂J/∂F = J F G⁻¹`` with ``G = FᵀF``) and of W.
+
+GLS/GLS* (L depends on u through every facet) and elastic masters (the
+segmentation would have to be linearized as well) are not covered.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import basix
+import numpy as np
+import numpy.typing as npt
+from petsc4py import PETSc
+
+from dolfinx_mortar.contact_terms import _GapBase
+from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, is_partition_of_unity, kind_name
+from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.layout import assemble_blocks
+from dolfinx_mortar.obstacles import RigidObstacle
+
+FloatArray = npt.NDArray[np.float64]
+
+DUAL_KINDS = (BasisKind.LcLS_star, BasisKind.LcLS)
+
+
+def area_element_derivatives(F: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``J = sqrt(det FᵀF)`` and its first and second derivatives with respect to F.
+
+    ``F``: (..., gdim, tdim). Returns J (...), dJ (..., gdim, tdim) and
+    d2J (..., gdim, tdim, gdim, tdim). With ``P = F G⁻¹``:
+    ``∂J/∂F_ia = J P_ia`` and
+    ``∂²J/∂F_ia∂F_jb = J (P_ia P_jb + δ_ij G⁻¹_ab − P_ib P_ja − (P Fᵀ)_ij G⁻¹_ab)``.
+    """
+    G = np.einsum("...ia,...ib->...ab", F, F)
+    Ginv = np.linalg.inv(G)
+    J = np.sqrt(np.linalg.det(G))
+    P = F @ Ginv
+    dJ = J[..., None, None] * P
+    gdim = F.shape[-2]
+    delta = np.eye(gdim)
+    PF = np.einsum("...ia,...ja->...ij", P, F)
+    d2J = (np.einsum("...ia,...jb->...iajb", P, P)
+           + np.einsum("ij,...ab->...iajb", delta, Ginv)
+           - np.einsum("...ib,...ja->...iajb", P, P)
+           - np.einsum("...ij,...ab->...iajb", PF, Ginv))
+    return J, dJ, J[..., None, None, None, None] * d2J
+
+
+@dataclass
+class CurrentState:
+    """Nodal quantities and their derivatives at one displacement."""
+
+    g: FloatArray            #: ĝ_A
+    W: FloatArray            #: W_A on the current surface
+    y: FloatArray            #: nodal gaps ĝ_A W_A^{−k}
+    G_g: PETSc.Mat           #: ∂ĝ/∂u
+    G_W: PETSc.Mat           #: ∂W/∂u
+    G_y: PETSc.Mat           #: ∂y/∂u
+    residual: PETSc.Vec      #: ∂Π/∂u
+    a: FloatArray            #: Σ_A F_g,A φ_A at the quadrature points (cells, points)
+    b: FloatArray            #: Σ_A F_W,A N_A at the quadrature points
+    element: dict            #: per-cell arrays the second derivatives need
+
+
+class CurrentObstacleGap(_GapBase):
+    """Penalty contact with a rigid obstacle, bases on the current surface.
+
+    Parameters
+    ----------
+    slave
+        The slave surface in the reference configuration.
+    obstacle
+        The rigid obstacle.
+    kind, penalty, scaling
+        As for :class:`~dolfinx_mortar.contact_terms.ObstacleGap`; GLS kinds are
+        not supported, dual kinds only on P1 lines and triangles.
+    quadrature_degree
+        Degree of the rule on every slave facet (default 2p + 2).
+    """
+
+    def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: KindLike,
+                 penalty: float, scaling: str = "consistent", quadrature_degree=None):
+        if is_global(kind):
+            raise NotImplementedError(
+                f"basis_configuration='current' with {kind_name(kind)}: L(u) couples every "
+                "slave facet and its linearization is not implemented; use a local kind")
+        super().__init__(slave, kind, penalty, scaling)
+        if obstacle.gdim != slave.gdim:
+            raise ValueError(f"a {obstacle.gdim}D obstacle cannot touch a {slave.gdim}D body")
+        ref = slave.reference
+        affine = ref.degree == 1 and ref.cell in ("interval", "triangle")
+        if self.kind in DUAL_KINDS and not affine:
+            raise NotImplementedError(
+                f"basis_configuration='current' with {kind_name(self.kind)} needs P1 lines or "
+                f"triangles (the dual coefficients of a {ref.name} change with its shape)")
+        if ref.transform is not None:
+            raise NotImplementedError("basis_configuration='current' with the transformed "
+                                      "quadratic basis is not implemented")
+        self.obstacle = obstacle
+        X, self.wq = basix.make_quadrature(ref.cell_type, quadrature_degree or 2 * ref.degree + 2)
+        self.N, self.dN = ref.tabulate(X, transformed=False)       # (q, nd), (q, tdim, nd)
+        if self.kind in DUAL_KINDS:
+            L_ref = np.einsum("q,qa,qb->ab", self.wq, self.N, self.N)
+            W_ref = self.wq @ self.N
+            self.C = np.linalg.solve(L_ref, np.diag(W_ref))
+        else:
+            self.C = np.eye(self.N.shape[1])
+        self.phi = self.N @ self.C                                 # φ_A = (N C)_A
+        #: exponents of y = ĝ W^{-k} and ω = ε W^m
+        self.k = 0 if (scaling == "seed" and is_partition_of_unity(self.kind)) else 1
+        self.m = 1 if scaling == "consistent" else 0
+        self.covered = self.basis.lumped_weights > 0
+
+    # -- element quantities ------------------------------------------------------------
+    def _elements(self, u_nodes: FloatArray) -> dict:
+        cells = self.slave.cells
+        x = (self.slave.x + u_nodes)[cells]                         # (c, nd, gdim)
+        F = np.einsum("cbi,qab->cqia", x, self.dN)                  # (c, q, gdim, tdim)
+        J, dJdF, d2JdF = area_element_derivatives(F)
+        # chain rule through F = Σ_b x_b ⊗ ∇N_b
+        dJ = np.einsum("cqia,qab->cqbi", dJdF, self.dN)             # (c, q, nd, gdim)
+        d2J = np.einsum("nqiajc,qab,qce->nqbiej", d2JdF, self.dN, self.dN)
+        xq = np.einsum("qb,cbi->cqi", self.N, x)
+        nc, nq, gdim = xq.shape
+        flat = xq.reshape(-1, gdim)
+        d = -self.obstacle.signed_distance(flat).reshape(nc, nq)
+        grad = -self.obstacle.gradient(flat).reshape(nc, nq, gdim)
+        hess = -self.obstacle.hessian(flat).reshape(nc, nq, gdim, gdim)
+        return {"J": J, "dJ": dJ, "d2J": d2J, "d": d, "grad": grad, "hess": hess}
+
+    def _nodal_coefficients(self, g: FloatArray, W: FloatArray, active: FloatArray):
+        """∂F/∂ĝ, ∂F/∂W and the second derivatives of F = (ε/2) W^m ⟨ĝ W^{−k}⟩²."""
+        eps, k, m = self.penalty, self.k, self.m
+        Wsafe = np.where(W > 0, W, 1.0)
+        y = g * Wsafe ** (-k)
+        yp = np.maximum(y, 0.0)
+        Fg = eps * Wsafe ** (m - k) * yp
+        FW = eps * yp ** 2 * Wsafe ** (m - 1) * (m / 2 - k)
+        Fgg = eps * Wsafe ** (m - 2 * k) * active
+        FgW = eps * Wsafe ** (m - k - 1) * yp * (m - 2 * k)
+        FWW = eps * (m / 2 - k) * yp ** 2 * Wsafe ** (m - 2) * ((m - 1) - 2 * k)
+        return y, Fg, FW, Fgg, FgW, FWW
+
+    def evaluate(self, u_nodes: FloatArray, mask: PETSc.Vec) -> CurrentState:
+        """Nodal gaps, their derivatives and the residual at ``u_nodes`` (local nodes).
+
+        ``mask``: 1 on free dofs, 0 on Dirichlet dofs (columns to drop).
+        """
+        e = self._elements(u_nodes)
+        cells, layout = self.slave.cells, self.slave.layout
+        nc, nd = cells.shape
+        gdim = self.slave.gdim
+        w = self.wq[None, :]
+        g_c = np.einsum("cq,qa->ca", w * e["J"] * e["d"], self.phi)
+        W_c = np.einsum("cq,qa->ca", w * e["J"], self.N)
+        v = np.einsum("cqi,qb->cqbi", e["grad"], self.N)             # ∇d_i N_b
+        dg_c = (np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["d"], e["dJ"])
+                + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["J"], v))
+        dW_c = np.einsum("q,qa,cqbi->cabi", self.wq, self.N, e["dJ"])
+        g = layout.sum_at_functions(cells, g_c)
+        W = layout.sum_at_functions(cells, W_c)
+        cols = self._node_dofs(cells).reshape(nc, nd * gdim)
+        G_g = assemble_blocks(layout, cells, self.dofs, cols, dg_c.reshape(nc, nd, nd * gdim))
+        G_W = assemble_blocks(layout, cells, self.dofs, cols, dW_c.reshape(nc, nd, nd * gdim))
+        G_g.diagonalScale(None, mask)
+        G_W.diagonalScale(None, mask)
+        y, Fg, FW, _, _, _ = self._nodal_coefficients(g, W, np.zeros_like(g))
+        residual = G_g.createVecRight()
+        tmp = G_W.createVecRight()
+        G_g.multTranspose(layout.vector(Fg), residual)
+        G_W.multTranspose(layout.vector(FW), tmp)
+        residual.axpy(1.0, tmp)
+        # ∂y = W^{-k} ∂ĝ − k y W^{-1} ∂W
+        Wsafe = np.where(W > 0, W, 1.0)
+        G_y = G_g.copy()
+        G_y.diagonalScale(layout.vector(Wsafe ** (-self.k)), None)
+        if self.k:
+            scaled = G_W.copy()
+            scaled.diagonalScale(layout.vector(-y / Wsafe), None)
+            G_y.axpy(1.0, scaled, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        a = np.einsum("ca,qa->cq", Fg[cells], self.phi)
+        b = np.einsum("ca,qa->cq", FW[cells], self.N)
+        #: ω_A for the problem's fallback and gap-closing start
+        self.weights = self.penalty * Wsafe ** self.m
+        self.current_weights = W
+        self.coefficients_std = np.broadcast_to(self.C, (nc, nd, nd)) * (
+            Wsafe[cells] ** (-self.k))[:, None, :]
+        return CurrentState(g, W, y, G_g, G_W, G_y, residual, a, b, e)
+
+    def jacobian(self, state: CurrentState, active: FloatArray, mask: PETSc.Vec,
+                 geometric: bool = True) -> PETSc.Mat:
+        """∂²Π/∂u² with ``active`` (0/1 per node) as the generalized H(y).
+
+        ``geometric=False`` keeps only ``G_yᵀ diag(ωH) G_y``, the part that a
+        frozen surface would give: positive semi-definite, for the iterations
+        in which the active set still moves (see ContactProblem._jacobian).
+        """
+        layout = self.slave.layout
+        if not geometric:
+            right = state.G_y.copy()
+            right.diagonalScale(layout.vector(self.weights * active), None)
+            return state.G_y.transposeMatMult(right)
+        _, _, _, Fgg, FgW, FWW = self._nodal_coefficients(state.g, state.W, active)
+
+        def scaled(M: PETSc.Mat, s: FloatArray) -> PETSc.Mat:
+            out = M.copy()
+            out.diagonalScale(layout.vector(s), None)
+            return out
+
+        # outer products: G_gᵀ(Fgg G_g + FgW G_W) + G_Wᵀ(FgW G_g + FWW G_W)
+        left = scaled(state.G_g, Fgg)
+        left.axpy(1.0, scaled(state.G_W, FgW), structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        right = scaled(state.G_g, FgW)
+        right.axpy(1.0, scaled(state.G_W, FWW), structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        K = state.G_g.transposeMatMult(left)
+        K.axpy(1.0, state.G_W.transposeMatMult(right),
+               structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        # element second derivatives: Σ_A F_g,A ∂²ĝ_A + F_W,A ∂²W_A
+        e = state.element
+        cells = self.slave.cells
+        nc, nd = cells.shape
+        gdim = self.slave.gdim
+        a, b, w = state.a, state.b, self.wq[None, :]
+        v = np.einsum("cqi,qb->cqbi", e["grad"], self.N)
+        blocks = (np.einsum("cq,cqbiej->cbiej", w * (a * e["d"] + b), e["d2J"])
+                  + np.einsum("cq,cqbi,cqej->cbiej", w * a, e["dJ"], v)
+                  + np.einsum("cq,cqbi,cqej->cbiej", w * a, v, e["dJ"])
+                  + np.einsum("cq,cq,cqij,qb,qe->cbiej", w * a, e["J"], e["hess"], self.N,
+                              self.N))
+        width = nd * gdim
+        local = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, width)
+        dofs = self._node_dofs(cells).reshape(nc, width)
+        K_el = assemble_blocks(self.dofs, local, self.dofs, dofs,
+                               blocks.reshape(nc, width, width))
+        K_el.diagonalScale(mask, mask)
+        K.diagonalScale(mask, mask)
+        K.axpy(1.0, K_el, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        return K
+
+    def energy(self, u_nodes: FloatArray) -> float:
+        """Π_c summed over all ranks (for checking the residual)."""
+        e = self._elements(u_nodes)
+        cells, layout = self.slave.cells, self.slave.layout
+        w = self.wq[None, :]
+        g = layout.sum_at_functions(cells, np.einsum("cq,qa->ca", w * e["J"] * e["d"],
+                                                     self.phi))
+        W = layout.sum_at_functions(cells, np.einsum("cq,qa->ca", w * e["J"], self.N))
+        Wsafe = np.where(W > 0, W, 1.0)
+        y = g * Wsafe ** (-self.k)
+        n = layout.num_owned
+        local = 0.5 * self.penalty * np.sum((Wsafe ** self.m * np.maximum(y, 0.0) ** 2)[:n])
+        return float(layout.comm.allreduce(local))
+
+    def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
+        """``p_A`` in the PU basis on the current surface (see ObstacleGap)."""
+        W = getattr(self, "current_weights", self.basis.lumped_weights)
+        force = self.penalty * np.where(W > 0, W, 1.0) ** self.m * np.maximum(gaps, 0.0)
+        if self.k == 0:
+            return force
+        return np.divide(force, W, out=np.zeros_like(W), where=W > 0)

@@ -1,0 +1,188 @@
+"""basis_configuration="current": exact residual and Jacobian on the current surface."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from dolfinx_mortar.facet_surface import nodal_displacement
+from dolfinx_mortar.finite_deformation import area_element_derivatives
+from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
+from dolfinx_mortar.problem import ContactProblem
+from jacobian_check import jacobian_error
+from test_problem import LOCAL_KINDS, block_on_plane, load
+
+
+@pytest.mark.parametrize("shape", [(2, 1), (3, 1), (3, 2)])
+def test_area_element_derivatives_match_differences(shape):
+    F = np.random.default_rng(3).normal(size=shape)
+    J, dJ, d2J = area_element_derivatives(F)
+    assert J == pytest.approx(np.sqrt(np.linalg.det(F.T @ F)))
+    h = 1e-6
+    for index in np.ndindex(*shape):
+        E = np.zeros(shape)
+        E[index] = h
+        Jp, dJp, _ = area_element_derivatives(F + E)
+        Jm, dJm, _ = area_element_derivatives(F - E)
+        assert (Jp - Jm) / (2 * h) == pytest.approx(dJ[index], abs=1e-8)
+        assert np.allclose((dJp - dJm) / (2 * h), d2J[(...,) + index], atol=1e-8)
+
+
+def _deformed_block(kind, scaling, n=(8, 3)):
+    """A block pressed into a rigid disk and sheared: several nodes active, and a
+    displacement (5% of the block) large enough for the bases to change."""
+    V, tags = block_on_plane(n=n)
+    problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -2.0], 2.01), E=1.0,
+                             nu=0.3, kind=kind, penalty=50.0, scaling=scaling,
+                             fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]},
+                             basis_configuration="current")
+    problem._set_load(1.0)
+    problem.u.interpolate(lambda x: np.vstack([0.05 * x[1] + 0.1 * x[0] ** 2,
+                                               -0.02 + 0.003 * x[0] ** 2 + 0.004 * x[0]]))
+    return problem
+
+
+def _energy_gradient_error(problem) -> float:
+    """|Π(u + h v) − Π(u − h v)|/2h against R_c·v: the residual is ∂Π/∂u."""
+    model = problem.gap_model
+    x0 = problem.u.vector.copy()
+    problem._residual(None, x0, problem.b)
+    Rc = problem._state.current.residual
+    v = x0.duplicate()
+    v.array[:] = np.random.default_rng(5 + MPI.COMM_WORLD.rank).normal(size=v.array.shape)
+    fem.petsc.set_bc(v, problem.bcs, scale=0.0)
+    h = 1e-6 / v.norm()
+    energies = []
+    for sign in (1, -1):
+        x0.copy(problem.u.vector)
+        problem.u.vector.axpy(sign * h, v)
+        problem.u.x.scatter_forward()
+        energies.append(model.energy(nodal_displacement(problem.slave, problem.u)))
+    x0.copy(problem.u.vector)
+    problem.u.x.scatter_forward()
+    exact = Rc.dot(v)
+    return abs((energies[0] - energies[1]) / (2 * h) - exact) / abs(exact)
+
+
+@pytest.mark.parametrize("scaling", ["consistent", "seed"])
+@pytest.mark.parametrize("kind", LOCAL_KINDS)
+def test_current_residual_is_the_gradient_and_the_jacobian_is_exact(kind, scaling):
+    problem = _deformed_block(kind, scaling)
+    gaps = problem.nodal_gaps()
+    n = problem.slave.layout.num_owned
+    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) >= 3
+    assert _energy_gradient_error(problem) < 1e-6
+    assert jacobian_error(problem) < 1e-7
+
+
+def test_current_jacobian_is_exact_on_curved_p2_facets():
+    domain = mesh.create_rectangle(MPI.COMM_WORLD, [[0, 0], [1, 0.5]], [6, 3])
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 2))
+    _, tags = block_on_plane(n=(6, 3))
+    tags = mesh.meshtags(domain, 1, tags.indices, tags.values)
+    problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -2.0], 2.01), E=1.0,
+                             nu=0.3, kind="LmLS*", penalty=50.0, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]}, basis_configuration="current")
+    problem._set_load(1.0)
+    # a curved slave surface: its area element varies along every facet
+    problem.u.interpolate(lambda x: np.vstack([0.05 * x[0] ** 2,
+                                               -0.02 + 0.03 * x[0] ** 2 - 0.02 * x[0] ** 3]))
+    assert _energy_gradient_error(problem) < 1e-6
+    assert jacobian_error(problem) < 1e-7
+
+
+def test_current_jacobian_is_exact_in_3d():
+    domain = mesh.create_box(MPI.COMM_WORLD, [[0, 0, 0], [1, 1, 0.5]], [4, 4, 2])
+    marks = [(1, lambda x: np.isclose(x[2], 0)), (2, lambda x: np.isclose(x[2], 0.5)),
+             (3, lambda x: np.isclose(x[0], 0)), (4, lambda x: np.isclose(x[1], 0))]
+    facets, values = [], []
+    for tag, where in marks:
+        f = mesh.locate_entities_boundary(domain, 2, where)
+        facets.append(f)
+        values.append(np.full(len(f), tag, dtype=np.int32))
+    facets, unique = np.unique(np.concatenate(facets), return_index=True)
+    tags = mesh.meshtags(domain, 2, facets.astype(np.int32), np.concatenate(values)[unique])
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    for kind in ("LcLS*", "LmLS"):
+        problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, 0.5, -2.0], 2.01),
+                                 E=1.0, nu=0.3, kind=kind, penalty=50.0,
+                                 fixed={3: {0: 0.0}, 4: {1: 0.0}},
+                                 tractions={2: [0.0, 0.0, -0.01]},
+                                 basis_configuration="current")
+        problem._set_load(1.0)
+        problem.u.interpolate(lambda x: np.vstack([0.05 * x[2] + 0.05 * x[0] * x[1],
+                                                   0.03 * x[0], -0.02 + 0.004 * x[1]]))
+        assert _energy_gradient_error(problem) < 1e-6
+        assert jacobian_error(problem) < 1e-7
+
+
+def _hertz2d_mesh(refine: str = "0.4"):
+    demo = load("hertz2d")
+    args = demo.parse_args(["--refine", refine])
+    domain, tags, h = demo.build_mesh(args, demo.hertz(args)["a"], MPI.COMM_WORLD)
+    return demo, fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags, h
+
+
+def _hertz2d_problem(mesh_data, configuration: str, traction: float) -> ContactProblem:
+    demo, V, tags, h = mesh_data
+    return ContactProblem(V, tags, demo.SLAVE, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0,
+                          nu=0.3, kind="LcLS*", penalty=1e3 / h,
+                          fixed={demo.SYMMETRY: {0: 0.0}},
+                          tractions={demo.LOAD: [0.0, -traction]},
+                          basis_configuration=configuration)
+
+
+def test_current_newton_converges_quadratically_from_the_small_deformation_solution():
+    """Strains of about 10%: the current surface moves the solution by a few percent."""
+    mesh_data = _hertz2d_mesh()       # one mesh: the two problems share its layout
+    initial = _hertz2d_problem(mesh_data, "initial", 0.02)
+    initial.solve(load_steps=4)
+    current = _hertz2d_problem(mesh_data, "current", 0.02)
+    current._set_load(1.0)
+    initial.u.vector.copy(current.u.vector)
+    current.u.x.scatter_forward()
+    snes = current._snes("quadratic_test_")
+    x = current.u.vector.copy()
+    snes.setConvergenceHistory(reset=True)
+    snes.solve(None, x)
+    r = np.array(snes.getConvergenceHistory()[0])
+    snes.destroy()
+    assert r[-1] < 1e-10 * r[0] and len(r) <= 5, r
+    e = r / r[0]
+    k = np.flatnonzero(r[1:] < 0.5 * r[:-1])[-1] + 1   # the last iterate that made progress
+    assert k >= 2 and np.log(e[k]) / np.log(e[k - 1]) > 1.7, r
+
+
+def test_previous_configuration_converges_to_current_as_the_steps_shrink():
+    """'previous' lags the bases by one load step: its error is first order in the
+    step, and it tends to the 'current' solution."""
+    mesh_data = _hertz2d_mesh()
+    demo = mesh_data[0]
+    current = _hertz2d_problem(mesh_data, "current", 0.005)
+    current.solve(load_steps=4)
+    p_current = demo.contact_results(current, demo.hertz(demo.parse_args([])))["p0"]
+    differences = []
+    for steps in (4, 16):
+        previous = _hertz2d_problem(mesh_data, "previous", 0.005)
+        previous.solve(load_steps=steps)
+        p0 = demo.contact_results(previous, demo.hertz(demo.parse_args([])))["p0"]
+        differences.append(abs(p0 - p_current) / p_current)
+    assert differences[1] < 0.35 * differences[0], differences   # ≈ ¼ per 4× steps
+    assert differences[1] < 1e-3
+
+
+def test_current_configuration_reports_what_it_cannot_do():
+    V, tags = block_on_plane()
+    common = dict(E=1.0, nu=0.3, penalty=10.0, basis_configuration="current")
+    with pytest.raises(NotImplementedError, match="GLS"):
+        ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), kind="GLS", **common)
+    with pytest.raises(NotImplementedError, match="segmentation"):
+        ContactProblem(V, tags, 1, master_tag=2, kind="LcLS*", **common)
+    with pytest.raises(NotImplementedError, match="nodal active set"):
+        ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), kind="LcLS*",
+                       active_set="pointwise", **common)
+    V2 = fem.VectorFunctionSpace(V.mesh, ("Lagrange", 2))
+    with pytest.raises(NotImplementedError, match="P1 lines or triangles"):
+        ContactProblem(V2, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), kind="LcLS*",
+                       **common)
