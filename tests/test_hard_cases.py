@@ -1,0 +1,183 @@
+"""Hard cases for numerical stability (issue 5).
+
+The scenes and the pass criteria live in benchmarks/hard_case_scenes.py, which
+also feeds the table of benchmarks/hard_cases.py: the tests and the table show
+the same numbers. Where a kind fails a case, the test is a strict xfail whose
+reason gives the measured figure, so the failure stays visible and a fix shows
+up as an XPASS.
+
+Operator-level cases run on COMM_SELF on every rank (dense condition numbers
+need the whole matrix); the problem-level cases run on COMM_WORLD and give the
+same numbers on 1 and 2 ranks.
+"""
+from __future__ import annotations
+
+import importlib.util
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+_path = Path(__file__).resolve().parent.parent / "benchmarks" / "hard_case_scenes.py"
+_spec = importlib.util.spec_from_file_location("hard_case_scenes", _path)
+scenes = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(scenes)
+
+ALL_KINDS = scenes.ALL_KINDS
+
+
+def failed(case: str, row: dict) -> list:
+    return [c for c in scenes.check(case, row) if not c[4]]
+
+
+def assert_passes(case: str, row: dict) -> None:
+    bad = failed(case, row)
+    assert not bad, f"{case} {row.get('kind')}: " + "; ".join(
+        f"{m} = {v:.3g} (need {op} {lim:g})" for m, v, op, lim, _ in bad)
+
+
+def xfail(*values, reason: str):
+    return pytest.param(*values, marks=pytest.mark.xfail(strict=True, reason=reason))
+
+
+# -- 1. contact boundary sweeping across a slave element edge ----------------------------
+@lru_cache(maxsize=None)
+def _sweep():
+    return {(r["kind"], r["boundary_modification"]): r for r in scenes.sweep()}
+
+
+SWEEP_VARIANTS = [(k, False) for k in ALL_KINDS] + [(k, True) for k in scenes.DUAL_KINDS]
+
+
+@pytest.mark.parametrize("kind, modified", SWEEP_VARIANTS)
+def test_sweep_penalty_jacobian_stays_conditioned(kind, modified):
+    """cond(K + Gᵀ εW G) over the sweep within 2× its value with the contact
+    edge on the node: a barely touched node only adds a tiny stiffness."""
+    assert_passes("sweep-jacobian", _sweep()[kind, modified])
+
+
+_D_REASON = ("contact block D over the touched nodes: cond grows like t^-3 (t = sliver/h) "
+             "for standard and global kinds, t^-2 for the dual ones; measured growth at "
+             "t = 1e-4: {}")
+
+
+@pytest.mark.parametrize("kind, modified", [
+    xfail("GLS", False, reason=_D_REASON.format("9.5e11")),
+    xfail("GLS*", False, reason=_D_REASON.format("9.5e11")),
+    xfail("LmLS", False, reason=_D_REASON.format("7.5e11")),
+    xfail("LmLS*", False, reason=_D_REASON.format("7.3e11")),
+    xfail("LcLS*", False, reason=_D_REASON.format("1.0e8")),
+    xfail("LcLS", False, reason=_D_REASON.format("1.0e8")),
+    xfail("LcLS*", True, reason=_D_REASON.format("1.0e8 (D = diag(W_cov): W_cov ~ t^2)")),
+    ("LcLS", True),   # modified LcLS: D = I on the touched nodes
+])
+def test_sweep_contact_block_conditioning(kind, modified):
+    """cond(D) over the touched nodes within 1e3× its value with the edge on a node."""
+    assert_passes("sweep-contact-block", _sweep()[kind, modified])
+
+
+@pytest.mark.parametrize("kind", [
+    xfail("LcLS*", reason="modified dual coefficients on the sliver grow like 1/t: "
+                          "max |C| 2 → 6.0e4 at t = 1e-4"),
+    xfail("LcLS", reason="modified dual coefficients on the sliver grow like 1/t^3: "
+                         "max |C| 32 → 9.6e13 at t = 1e-4"),
+])
+def test_sweep_boundary_modification_keeps_coefficients_bounded(kind):
+    """The consistent boundary modification rebuilds the dual basis on the
+    covered part: on a sliver its coefficients explode (the seed's warning)."""
+    assert_passes("sweep-modified-coefficients", _sweep()[kind, True])
+
+
+def test_sweep_covered_area_is_the_overlap():
+    r = _sweep()["LcLS*", False]
+    expected = [1.0 - (3 / 8 + t / 8) for t in r["offsets"]]
+    assert np.allclose(r["covered_area"], expected, rtol=0, atol=1e-14)
+
+
+# -- 2. quadratic slave facets ------------------------------------------------------------
+@pytest.mark.parametrize("variant", ["P2-triangle", "Q8", "Q9"])
+@pytest.mark.parametrize("kind", ALL_KINDS)
+def test_quadratic_facets_transfer_linear_fields_exactly(kind, variant):
+    """D·f_s = M·f_m for f = 1, x, y and the exact covered area (P2 triangles
+    and Q8 with the transformed basis)."""
+    assert_passes("quadratic-identities", scenes.quadratic_identities(kind, variant))
+
+
+@pytest.mark.parametrize("kind", ALL_KINDS)
+def test_quadratic_tetrahedra_pass_the_patch_test(kind):
+    """3D patch test with P2 tetrahedra: transformed P2 triangle slave facets."""
+    for orientation in ("finer-slave", "finer-master"):
+        assert_passes("patch", scenes.patch_test_run(kind, 3, 2, 0.35, 0.5, orientation))
+
+
+# -- 3. mesh-size ratio 1:10 ----------------------------------------------------------------
+@pytest.mark.parametrize("orientation", ["finer-slave", "finer-master"])
+@pytest.mark.parametrize("kind", ALL_KINDS)
+def test_patch_test_with_mesh_size_ratio_ten(kind, orientation):
+    assert_passes("patch", scenes.patch_test_run(kind, 2, 1, 0.02, 0.2, orientation))
+
+
+# -- 4. penalty up to 1e4·E/h -------------------------------------------------------------
+@pytest.mark.parametrize("kind", ALL_KINDS)
+def test_penetration_falls_as_one_over_the_penalty(kind):
+    """Hertz 2D on a rigid plane, ε = 1e1..1e4·E/h: max d̄ ∝ ε^-1 (slope within
+    0.05), at most 10 Newton iterations per load step, cond of the Newton
+    matrix growing no faster than ε^1.1."""
+    assert_passes("penalty", scenes.penalty_sweep(kind))
+
+
+# -- 5. grazing contact ----------------------------------------------------------------------
+@pytest.mark.parametrize("kind", ALL_KINDS)
+def test_grazing_disk_converges_with_non_negative_pressure(kind):
+    assert_passes("grazing", scenes.grazing(kind))
+
+
+# -- 6. 3D coincident nodes and edges --------------------------------------------------------
+@pytest.mark.parametrize("variant", [("tetrahedron", False), ("tetrahedron", True),
+                                     ("hexahedron", False)],
+                         ids=["tet-identical", "tet-crossing-diagonals", "hex-identical"])
+@pytest.mark.parametrize("kind", ALL_KINDS)
+def test_coincident_interface_meshes(kind, variant):
+    """Identical interface meshes (and coincident nodes with crossing
+    diagonals): exact covered area, no failed projection, exact patch test."""
+    assert_passes("coincident", scenes.coincident_patch(kind, *variant))
+
+
+# -- 7. curved on curved: Hertz with two elastic bodies ---------------------------------------
+_GLS_RINGING = ("GLS gaps d̄ = L⁻¹ĝ with L over the whole slave surface ring past the "
+                "covered zone: at zero load the first uncovered node gets d̄ = +6.4e-3 "
+                "(0.31 h); the residual applies its force, the Jacobian (covered nodes "
+                "only) does not")
+
+
+@pytest.mark.parametrize("kind", [xfail("GLS", reason=_GLS_RINGING),
+                                  xfail("GLS*", reason=_GLS_RINGING),
+                                  "LmLS", "LmLS*", "LcLS*", "LcLS"])
+def test_touching_cylinders_have_no_penetration_at_zero_load(kind):
+    assert_passes("spurious-gap", scenes.spurious_gap(kind))
+
+
+_GLS_NEWTON = pytest.mark.xfail(
+    run=False, reason="not run: Newton diverges through every load-step cut (measured at "
+                      "contact size a/6: residual 1.32 at u = 0 whatever the load, from the "
+                      "spurious gaps of the test above), and each augmented MUMPS "
+                      "factorization at this mesh (22k dofs) takes over a minute")
+
+
+@pytest.mark.parametrize("kind", [pytest.param("GLS", marks=_GLS_NEWTON),
+                                  pytest.param("GLS*", marks=_GLS_NEWTON),
+                                  "LmLS", "LmLS*", "LcLS*", "LcLS"])
+def test_two_cylinders_match_hertz(kind):
+    """p0 and a within 3% (contact size a/20)."""
+    assert_passes("cylinders", scenes.two_cylinders(kind))
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(run=False, reason="scene not validated: the two-sphere octants of "
+                   "hard_case_scenes.two_spheres give p0 error +392 (LcLS*) and Newton "
+                   "divergence (LmLS): a scene bug is suspected, not diagnosed yet")
+@pytest.mark.parametrize("kind", ALL_KINDS)
+def test_two_spheres_match_hertz(kind):
+    """p0 within 15%, a within 10% (contact size a/4)."""
+    assert_passes("spheres", scenes.two_spheres(kind))
