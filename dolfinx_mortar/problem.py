@@ -450,7 +450,9 @@ class ContactProblem:
             clock = time.perf_counter()
             x = self.u.vector.copy()
             snes.setConvergenceHistory(reset=True)
+            solve_clock = time.perf_counter()
             snes.solve(None, x)
+            self._add("snes_solve", solve_clock)  # includes the callbacks' times
             reason = snes.getConvergedReason()
             history = list(snes.getConvergenceHistory()[0])
             if reason <= 0:
@@ -549,6 +551,8 @@ class AugmentedNewtonStep:
         self.comm = comm
         self.prefix = prefix
         self.ksp: Optional[PETSc.KSP] = None
+        #: wall time of the factorizations (a linear-solve cost spent in the Jacobian callback)
+        self.factorization_time = 0.0
 
     def update(self, K: PETSc.Mat, G: PETSc.Mat, weights: FloatArray, L: PETSc.Mat) -> None:
         layout_vec = L.createVecLeft()
@@ -571,7 +575,9 @@ class AugmentedNewtonStep:
             self.ksp.setOptionsPrefix(self.prefix)
             self.ksp.setFromOptions()
         self.ksp.setOperators(A)
+        clock = time.perf_counter()
         self.ksp.setUp()
+        self.factorization_time += time.perf_counter() - clock
         self.A = A
         self.rhs, self.sol = A.createVecRight(), A.createVecLeft()
 
