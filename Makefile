@@ -25,7 +25,7 @@ help:
 	@echo "make demo   - setup, then the main demo (Hertz 2D, figures 1 and 2) into results/"
 	@echo "make test   - setup, then C++ tests (ctest), pytest, and pytest under mpirun -n 2"
 	@echo "make bench  - setup, then the benchmarks in benchmarks/ (speed vs error: --quick)"
-	@echo "make bench-speed - setup, then the full speed-vs-error study (~25 min, 1 core)"
+	@echo "make bench-speed - setup, then the full speed-vs-error study (~25 min, serial)"
 	@echo "make stress - setup, then 1e6 generated slave-master pairs through 3D segmentation"
 
 setup: deps build install
