@@ -18,13 +18,14 @@ DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 # libopenblas0-serial replaces the reference BLAS behind PETSc/MUMPS: 3.7x faster
 # factorizations on Hertz 3D (33 s -> 8.8 s), serial so it does not fight MPI ranks.
 
-.PHONY: help setup deps build install demo test test-cpp test-python test-mpi bench stress clean
+.PHONY: help setup deps build install demo test test-cpp test-python test-mpi bench bench-speed stress clean
 
 help:
 	@echo "make setup  - install missing Debian packages, build the kernels, make dolfinx_mortar importable"
 	@echo "make demo   - setup, then the main demo (Hertz 2D, figures 1 and 2) into results/"
 	@echo "make test   - setup, then C++ tests (ctest), pytest, and pytest under mpirun -n 2"
-	@echo "make bench  - setup, then the benchmarks in benchmarks/"
+	@echo "make bench  - setup, then the benchmarks in benchmarks/ (speed vs error: --quick)"
+	@echo "make bench-speed - setup, then the full speed-vs-error study (~25 min, serial)"
 	@echo "make stress - setup, then 1e6 generated slave-master pairs through 3D segmentation"
 
 setup: deps build install
@@ -73,6 +74,10 @@ test-mpi:
 bench: setup
 	$(PYTHON) benchmarks/bench_basis_construction.py
 	$(PYTHON) benchmarks/bench_segmentation.py
+	$(PYTHON) benchmarks/speed_vs_error.py --quick
+
+bench-speed: setup
+	$(PYTHON) benchmarks/speed_vs_error.py
 
 stress: setup
 	$(BUILD_DIR)/kernels/stress_segmentation 1000000 1

@@ -149,14 +149,16 @@ def problem_radius(problem) -> float:
                                              op=MPI.MAX))
 
 
-def main(argv: Optional[Sequence[str]] = None) -> dict:
-    args = parse_args(argv)
+def build_problem(args: argparse.Namespace, comm: MPI.Comm):
+    """The mesh and the contact problem of the scene (not solved yet).
+
+    Returns the problem, the Hertz reference (:func:`hertz`) and the contact
+    element size.
+    """
     from dolfinx import fem
     from dolfinx_mortar.obstacles import RigidPlane
     from dolfinx_mortar.problem import ContactProblem
-    comm = MPI.COMM_WORLD
     ref = hertz(args)
-    clock = time.perf_counter()
     domain, facet_tags, h_contact = build_mesh(args, ref["a"], comm)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", args.degree))
     fixed = {SYMMETRY: {0: 0.0}}
@@ -173,9 +175,14 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
                              fixed=fixed,
                              tractions={LOAD: [0.0, -args.force / (2 * args.radius)]},
                              **kwargs)
-    result = problem.solve(load_steps=args.load_steps, output=args.output,
-                           progress=comm.rank == 0)
-    wall = time.perf_counter() - clock
+    return problem, ref, h_contact
+
+
+def key_figures(args: argparse.Namespace, problem, result, ref: dict, h_contact: float,
+                wall: float) -> dict:
+    """Errors against Hertz and the run's size and cost, on every rank."""
+    comm = problem.mesh.comm
+    V = problem.V
     figures = contact_results(problem, ref)
     dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
     figures.update({
@@ -189,6 +196,19 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
         "basis_configuration": args.basis_configuration,
         "degree": args.degree, "refine": args.refine, "ranks": comm.size,
     })
+    return figures
+
+
+def main(argv: Optional[Sequence[str]] = None) -> dict:
+    args = parse_args(argv)
+    comm = MPI.COMM_WORLD
+    clock = time.perf_counter()
+    problem, ref, h_contact = build_problem(args, comm)
+    result = problem.solve(load_steps=args.load_steps, output=args.output,
+                           progress=comm.rank == 0)
+    wall = time.perf_counter() - clock
+    figures = key_figures(args, problem, result, ref, h_contact, wall)
+    dofs = figures["dofs"]
     if comm.rank == 0:
         print(f"Hertz 2D ({args.obstacle} obstacle, {args.kind}, P{args.degree}, "
               f"{dofs} dofs, {comm.size} rank(s))")

@@ -16,6 +16,7 @@ A surface is anything with ``layout``, ``cells``, ``description``,
 """
 from __future__ import annotations
 
+import time
 from typing import Any, Callable, Optional, Union
 
 import numpy as np
@@ -53,6 +54,7 @@ class MortarBasis:
 
     def __init__(self, kind: KindLike, surface: Any,
                  quadrature_degree: Optional[int] = None):
+        clock = time.perf_counter()
         self.kind: BasisKind = parse_kind(kind)
         self.surface = surface
         self.layout = surface.layout
@@ -84,6 +86,8 @@ class MortarBasis:
                     self.kind, mass, self.element_weights, nodal_at_cells)
         except ValueError as err:
             raise ValueError(f"{surface.description}: {err}{_hint(surface)}") from None
+        #: wall time in seconds of the construction on this rank (benchmarks)
+        self.construction_time = time.perf_counter() - clock
 
     @property
     def element_mass(self) -> FloatArray:

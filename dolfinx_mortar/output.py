@@ -9,7 +9,7 @@ import json
 import os
 import tempfile
 from pathlib import Path
-from typing import Any, Callable, Union
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 PathLike = Union[str, os.PathLike]
 
@@ -51,3 +51,21 @@ def save_figure(path: PathLike, figure: Any, **kwargs: Any) -> Path:
     """Save a matplotlib figure atomically (format from the suffix)."""
     fmt = Path(path).suffix.lstrip(".") or "png"
     return write_atomically(path, lambda tmp: figure.savefig(tmp, format=fmt, **kwargs))
+
+
+def write_csv(path: PathLike, rows: Sequence[Mapping[str, Any]],
+              columns: Optional[Sequence[str]] = None) -> Path:
+    """Write dict rows as CSV with a header, atomically.
+
+    ``columns`` fixes the order (default: the keys of the first row); keys
+    missing from a row are left empty.
+    """
+    import csv
+    fields = list(columns) if columns is not None else list(rows[0]) if rows else []
+
+    def write(tmp: str) -> None:
+        with open(tmp, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+            writer.writeheader()
+            writer.writerows(rows)
+    return write_atomically(path, write)

@@ -591,7 +591,9 @@ class ContactProblem:
             try:
                 self._close_gaps(snes, x)
                 snes.setConvergenceHistory(reset=True)
+                solve_clock = time.perf_counter()
                 snes.solve(None, x)
+                self._add("snes_solve", solve_clock)  # includes the callbacks' times
             finally:
                 if current is not None:
                     self.gap_model = current
@@ -765,6 +767,8 @@ class AugmentedNewtonStep:
         self.comm = comm
         self.prefix = prefix
         self.ksp: Optional[PETSc.KSP] = None
+        #: wall time of the factorizations (a linear-solve cost spent in the Jacobian callback)
+        self.factorization_time = 0.0
 
     def update(self, K: PETSc.Mat, G: PETSc.Mat, weights: FloatArray, L: PETSc.Mat,
                G_linearized: Optional[PETSc.Mat] = None) -> None:
@@ -792,7 +796,9 @@ class AugmentedNewtonStep:
             self.ksp.setOptionsPrefix(self.prefix)
             self.ksp.setFromOptions()
         self.ksp.setOperators(A)
+        clock = time.perf_counter()
         self.ksp.setUp()
+        self.factorization_time += time.perf_counter() - clock
         self.A = A
         self.rhs, self.sol = A.createVecRight(), A.createVecLeft()
 
