@@ -30,7 +30,7 @@ from dolfinx_mortar.basis import MortarBasis
 from dolfinx_mortar.kinds import (BasisKind, KindLike, is_global, is_partition_of_unity,
                                   kind_name, parse_kind, unstarred_partner)
 from dolfinx_mortar.lagrange import LagrangeSurface
-from dolfinx_mortar.layout import NodeLayout, assemble_blocks
+from dolfinx_mortar.layout import MassMatrixSolver, NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar import MortarCoupling
 from dolfinx_mortar.obstacles import RigidObstacle
 
@@ -79,6 +79,11 @@ class _GapBase:
         C = self.basis.coefficients
         #: M̄ = N_std C_std on each slave cell (N_std: the displacement's basis)
         self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
+
+    @property
+    def lumped_weights(self) -> FloatArray:
+        """``W_A = ∫ N_A`` of the configuration the bases live in."""
+        return self.basis.lumped_weights
 
     def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """Pressure coefficients ``p_A`` of the contact traction in a PU basis.
@@ -219,6 +224,21 @@ class MortarGap(_GapBase):
         return self.gaps0 + self.slave.layout.to_local(Gu)
 
 
+def covered_mass(coupling: MortarCoupling) -> tuple[MassMatrixSolver, FloatArray]:
+    """``L_AB = ∫_cov N_A N_B`` over the covered slave area, factorized, and its
+    row sums ``W_A = ∫_cov N_A``. Nodes with no covered support get a unit row
+    (their gap is 0 and their weight 0)."""
+    slave = coupling.slave
+    nd = slave.cells.shape[1]
+    covered_cells = np.unique(coupling.pairs[:, 0])
+    L = np.zeros((len(slave.cells), nd, nd))
+    np.add.at(L, coupling.pairs[:, 0], coupling.D_pairs)
+    cells = slave.cells[covered_cells]
+    W = slave.layout.sum_at_functions(cells, L[covered_cells].sum(axis=2))
+    matrix = slave.layout.assemble_matrix(cells, L[covered_cells])
+    return MassMatrixSolver(slave.layout, matrix), W
+
+
 class GlobalGap:
     """Nodal gaps of GLS and GLS*: ``d̄ = L⁻¹ ĝ(u)`` with ``ĝ_B = ∫ N_B d``.
 
@@ -234,7 +254,16 @@ class GlobalGap:
         self.scaling = scaling
         self.slave = inner.slave
         self.basis = MortarBasis(BasisKind.GLS, self.slave)
-        W = self.basis.lumped_weights
+        if isinstance(inner, MortarGap):
+            # The projection d̄ = L⁻¹ĝ must see d only where it exists: with L
+            # over the whole surface, the uncovered part counts as d = 0 and
+            # the gaps ring past the covered zone (a node beyond it got
+            # d̄ = +0.31 h on two touching cylinders at zero load).
+            self.mass, W = covered_mass(inner.coupling)
+        else:
+            self.mass, W = self.basis._solver, self.basis.lumped_weights
+        #: W_A = ∫ N_A over the part that enters the projection
+        self.lumped_weights = W
         # Π_c = Σ (ω_A/2)⟨d̄_A⟩² in terms of the GLS gap d̄ (∫M_A = 1):
         # consistent ω = εW; seed GLS ω = ε; seed GLS* (d_A = W_A d̄_A) ω = εW².
         if scaling == "consistent":
@@ -244,11 +273,11 @@ class GlobalGap:
         else:
             self.weights = penalty * W ** 2
         self.dofs = inner.dofs
-        self.mass = self.basis._solver
         self.covered = inner.covered
+        self.weights = np.where(self.covered, self.weights, 0.0)
 
     def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """``p_A = ω_A⟨d̄_A⟩/W_A`` (coefficients of the traction in the PU basis GLS*)."""
-        W = self.basis.lumped_weights
+        W = self.lumped_weights
         force = self.weights * (np.maximum(gaps, 0.0) if positive_part else gaps)
         return np.divide(force, W, out=np.zeros_like(W), where=W > 0)

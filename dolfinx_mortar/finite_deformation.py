@@ -197,7 +197,7 @@ class CurrentObstacleGap(_GapBase):
         b = np.einsum("ca,qa->cq", FW[cells], self.N)
         #: ω_A for the problem's fallback and gap-closing start
         self.weights = self.penalty * Wsafe ** self.m
-        self.current_weights = W
+        self._current_weights = W
         self.coefficients_std = np.broadcast_to(self.C, (nc, nd, nd)) * (
             Wsafe[cells] ** (-self.k))[:, None, :]
         return CurrentState(g, W, y, G_g, G_W, G_y, residual, a, b, e)
@@ -266,9 +266,14 @@ class CurrentObstacleGap(_GapBase):
         local = 0.5 * self.penalty * np.sum((Wsafe ** self.m * np.maximum(y, 0.0) ** 2)[:n])
         return float(layout.comm.allreduce(local))
 
+    @property
+    def lumped_weights(self) -> FloatArray:
+        """W_A on the surface of the last evaluation (the reference one before)."""
+        return getattr(self, "_current_weights", self.basis.lumped_weights)
+
     def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """``p_A`` in the PU basis on the current surface (see ObstacleGap)."""
-        W = getattr(self, "current_weights", self.basis.lumped_weights)
+        W = self.lumped_weights
         force = self.penalty * np.where(W > 0, W, 1.0) ** self.m * np.maximum(gaps, 0.0)
         if self.k == 0:
             return force

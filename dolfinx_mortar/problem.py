@@ -439,8 +439,6 @@ class ContactProblem:
         the contact must hold makes the Jacobian singular. Once a node is
         active the Jacobian is exact again.
         """
-        if getattr(self, "_active_override", None) is not None:
-            return self._active_override
         # Nodes with no master below them have no gap (d̄ = 0 because nothing is
         # integrated there): they are never active.
         covered = self.gap_model.covered
@@ -459,10 +457,12 @@ class ContactProblem:
         d̄ < 0 at every node, no contact force, and Newton's linear model —
         stiff only from the current gap on — creeps towards the obstacle by
         F/(εA) per iteration. This step solves the linear model in which the
-        closest nodes near contact (:meth:`_active`) carry the force
-        ``ω(d̄ + GΔu)``, which closes the gap there. It changes only where
-        Newton starts, not the solution. GLS kinds skip it (their d̄ = L⁻¹ĝ
-        changes sign anyway).
+        nodes near contact (:meth:`_active`) carry the force ``ω(d̄ + GΔu)``,
+        which closes their gaps: it overshoots by about the largest of those
+        gaps (a tenth of an element), which Newton then takes back. Pulling
+        only the closest node instead left rotations about it free (singular
+        on a grazing disk). It changes only where Newton starts, not the
+        solution. GLS kinds skip it (their d̄ = L⁻¹ĝ changes sign anyway).
         """
         if isinstance(self.gap_model, GlobalGap):
             return
@@ -476,23 +476,11 @@ class ContactProblem:
         near = self._active(state.gaps)
         if self.mesh.comm.allreduce(int(np.sum(near[:n]))) == 0:
             return
-        # pull only the closest nodes to d̄ = 0: pulling every stiffened node
-        # shut would push the first touch as deep as the farthest one's gap
-        covered = self.gap_model.covered
-        closest = self.mesh.comm.allreduce(
-            float(np.max(state.gaps[:n][covered[:n]], initial=-np.inf)), op=MPI.MAX)
-        pulled = near * (state.gaps >= closest - 1e-6 * abs(closest))
         J = self._total_matrix()
-        # only the pulled nodes are springs: stiff nodes that start at d̄ < 0
-        # would hold the body up and leave the pulled ones short of contact
-        self._active_override = pulled
-        try:
-            self._jacobian(snes, x, J, J)
-        finally:
-            self._active_override = None
+        self._jacobian(snes, x, J, J)
         rhs = self.b.copy()
         pull = state.G.createVecRight()
-        state.G.multTranspose(self.slave.layout.vector(self.gap_model.weights * pulled
+        state.G.multTranspose(self.slave.layout.vector(self.gap_model.weights * near
                                                        * state.gaps), pull)
         rhs.axpy(1.0, pull)
         ksp = snes.getKSP()
@@ -707,7 +695,7 @@ class ContactProblem:
         n = self.slave.layout.num_owned
         p = self.nodal_pressures()
         # the weights of the configuration the bases live in
-        W = getattr(self.gap_model, "current_weights", self.gap_model.basis.lumped_weights)
+        W = self.gap_model.lumped_weights
         return float(self.mesh.comm.allreduce(float(np.sum((W * p)[:n]))))
 
     def _open_output(self, path: Path) -> None:
