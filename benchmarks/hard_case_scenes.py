@@ -106,7 +106,7 @@ def newton_matrix(problem):
 class _Capture:
     """Stands in for AugmentedNewtonStep to capture the pieces of its matrix."""
 
-    def update(self, K, G, weights, L, G_linearized=None):
+    def update(self, K, G, weights, L, G_linearized=None, surface=None):
         if G_linearized is not None and G_linearized is not G:
             raise NotImplementedError("condition numbers of the pointwise GLS step")
         self.K, self.G, self.weights, self.L = K, G, weights, L

@@ -274,6 +274,9 @@ class GlobalGap:
             self.weights = penalty * W ** 2
         self.dofs = inner.dofs
         self.covered = inner.covered
+        #: owned local nodes of the slave surface (the rows the Newton step needs)
+        owned = np.unique(self.slave.cells)
+        self.surface_rows = owned[owned < self.slave.layout.num_owned]
         self.weights = np.where(self.covered, self.weights, 0.0)
 
     def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
