@@ -82,8 +82,9 @@ class _GapBase:
 
     @property
     def lumped_weights(self) -> FloatArray:
-        """``W_A = ∫ N_A`` of the configuration the bases live in."""
-        return self.basis.lumped_weights
+        """``W_A = ∫ N_A`` of the configuration the bases live in (over the
+        covered part with the boundary modification)."""
+        return getattr(self, "_weights_source", self.basis.lumped_weights)
 
     def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """Pressure coefficients ``p_A`` of the contact traction in a PU basis.
@@ -98,7 +99,7 @@ class _GapBase:
         force = self.weights * (np.maximum(gaps, 0.0) if positive_part else gaps)
         if is_partition_of_unity(self.basis.kind):
             return force
-        W = self.basis.lumped_weights
+        W = self.lumped_weights
         return np.divide(force, W, out=np.zeros_like(W), where=W > 0)
 
     def _node_dofs(self, nodes: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
@@ -177,7 +178,8 @@ class MortarGap(_GapBase):
     """
 
     def __init__(self, coupling: MortarCoupling, kind: KindLike, penalty: float,
-                 scaling: str = "consistent", reference: Optional[PETSc.Vec] = None):
+                 scaling: str = "consistent", reference: Optional[PETSc.Vec] = None,
+                 boundary_modification: bool = False):
         self.reference = reference
         super().__init__(coupling.slave, kind, penalty, scaling)
         if coupling.master.layout is not coupling.slave.layout and (
@@ -185,6 +187,17 @@ class MortarGap(_GapBase):
             raise ValueError("MortarGap needs slave and master in one mesh (one displacement "
                              "space); two meshes are supported by MortarCoupling only")
         self.coupling = coupling
+        self._weights_source = self.basis.lumped_weights
+        if boundary_modification:
+            # dual basis rebuilt over the covered part of every covered cell
+            # (Popp et al. 2013); its ∫_cov M̄_A = 1 pairs it with W_cov
+            C = coupling._covered_coefficients(self.basis.kind)
+            T = self.slave.reference.transform
+            self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
+            _, _, W_cov = covered_element_mass(coupling)
+            self._weights_source = W_cov
+            if scaling == "consistent":
+                self.weights = self.penalty * W_cov
         C = self.coefficients_std[coupling.pairs[:, 0]]
         Dn, Mn, gn = coupling.raw_pairs
         Dg = np.einsum("pba,pbc->pac", C, Dn)        # ∫ M̄_A N_B
@@ -224,18 +237,27 @@ class MortarGap(_GapBase):
         return self.gaps0 + self.slave.layout.to_local(Gu)
 
 
-def covered_mass(coupling: MortarCoupling) -> tuple[MassMatrixSolver, FloatArray]:
-    """``L_AB = ∫_cov N_A N_B`` over the covered slave area, factorized, and its
-    row sums ``W_A = ∫_cov N_A``. Nodes with no covered support get a unit row
-    (their gap is 0 and their weight 0)."""
+def covered_element_mass(coupling: MortarCoupling
+                         ) -> tuple[FloatArray, npt.NDArray[np.int64], FloatArray]:
+    """Element matrices ``∫_cov N_A N_B`` of every slave cell, the covered cells,
+    and the nodal ``W_A = ∫_cov N_A`` (summed over ranks)."""
     slave = coupling.slave
     nd = slave.cells.shape[1]
     covered_cells = np.unique(coupling.pairs[:, 0])
     L = np.zeros((len(slave.cells), nd, nd))
     np.add.at(L, coupling.pairs[:, 0], coupling.D_pairs)
-    cells = slave.cells[covered_cells]
-    W = slave.layout.sum_at_functions(cells, L[covered_cells].sum(axis=2))
-    matrix = slave.layout.assemble_matrix(cells, L[covered_cells])
+    W = slave.layout.sum_at_functions(slave.cells[covered_cells],
+                                      L[covered_cells].sum(axis=2))
+    return L, covered_cells, W
+
+
+def covered_mass(coupling: MortarCoupling) -> tuple[MassMatrixSolver, FloatArray]:
+    """``L_AB = ∫_cov N_A N_B`` over the covered slave area, factorized, and its
+    row sums ``W_A = ∫_cov N_A``. Nodes with no covered support get a unit row
+    (their gap is 0 and their weight 0)."""
+    slave = coupling.slave
+    L, covered_cells, W = covered_element_mass(coupling)
+    matrix = slave.layout.assemble_matrix(slave.cells[covered_cells], L[covered_cells])
     return MassMatrixSolver(slave.layout, matrix), W
 
 

@@ -23,7 +23,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_kind
 from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
 from dolfinx_mortar.finite_deformation import CurrentObstacleGap, CurrentState
-from dolfinx_mortar.kinds import KindLike, is_global, kind_name, parse_kind
+from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.mortar import MortarCoupling
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.obstacles import RigidObstacle
@@ -164,6 +164,11 @@ class ContactProblem:
         ``{tag: vector}``: surface tractions at load factor 1.
     quadratic_transform
         Transformed basis on quadratic triangle facets.
+    boundary_modification
+        Elastic master, dual kinds (LcLS*, LcLS): rebuild the basis over the
+        covered part of partly covered slave facets (Popp et al. 2013).
+        Without it a dual function that is negative on the covered part turns
+        a separated node's gap positive (false penetration).
     """
 
     def __init__(self, V: fem.FunctionSpace, facet_tags, slave_tag: int, *,
@@ -172,7 +177,7 @@ class ContactProblem:
                  scaling: str = "consistent", active_set: str = "nodal",
                  basis_configuration: str = "initial",
                  fixed: Optional[dict] = None, tractions: Optional[dict] = None,
-                 quadratic_transform: bool = False):
+                 quadratic_transform: bool = False, boundary_modification: bool = False):
         mesh = V.mesh
         gdim = mesh.geometry.dim
         if V.dofmap.index_map_bs != gdim:
@@ -198,6 +203,11 @@ class ContactProblem:
             raise ValueError(f"a {obstacle.gdim}D obstacle in a {gdim}D mesh: the option "
                              "does not fit the mesh's dimension")
         gap_kind(kind, scaling)  # validates kind and scaling early
+        if boundary_modification and (master_tag is None or parse_kind(kind) not in (
+                BasisKind.LcLS_star, BasisKind.LcLS)):
+            raise ValueError("the consistent boundary modification applies to the dual kinds "
+                             "(LcLS*, LcLS) with an elastic master (master_tag)")
+        self.boundary_modification = boundary_modification
         fixed, tractions = fixed or {}, tractions or {}
         present = {int(t) for values in mesh.comm.allgather(np.unique(facet_tags.values))
                    for t in values}
@@ -285,7 +295,8 @@ class ContactProblem:
                 coupling = MortarCoupling(self.slave.moved(u_nodes), self.master.moved(u_nodes),
                                           keep_points=keep)
             reference = self.u.vector.copy() if u_nodes is not None else None
-            model = MortarGap(coupling, self.kind, self.penalty, self.scaling, reference)
+            model = MortarGap(coupling, self.kind, self.penalty, self.scaling, reference,
+                              boundary_modification=self.boundary_modification)
         self.gap_model = (GlobalGap(model, self.kind, self.penalty, self.scaling)
                           if is_global(self.kind) else model)
         self._A_total: Optional[PETSc.Mat] = None
