@@ -164,6 +164,11 @@ class ContactProblem:
         ``{tag: vector}``: surface tractions at load factor 1.
     quadratic_transform
         Transformed basis on quadratic triangle facets.
+    search_radius
+        How far apart slave and master facets may be and still be paired
+        (:class:`MortarCoupling`; default the largest slave facet diameter).
+        Every slave cell should be either fully covered or not at all: a
+        partly covered cell gives the dual kinds spurious positive gaps.
     """
 
     def __init__(self, V: fem.FunctionSpace, facet_tags, slave_tag: int, *,
@@ -172,7 +177,8 @@ class ContactProblem:
                  scaling: str = "consistent", active_set: str = "nodal",
                  basis_configuration: str = "initial",
                  fixed: Optional[dict] = None, tractions: Optional[dict] = None,
-                 quadratic_transform: bool = False):
+                 quadratic_transform: bool = False,
+                 search_radius: Optional[float] = None):
         mesh = V.mesh
         gdim = mesh.geometry.dim
         if V.dofmap.index_map_bs != gdim:
@@ -216,6 +222,7 @@ class ContactProblem:
         self.basis_configuration = basis_configuration
         self.active_set = active_set
         self.obstacle = obstacle
+        self.search_radius = search_radius
         self.load = fem.Constant(mesh, PETSc.ScalarType(0.0))
 
         # bulk: small strain, plane strain in 2D
@@ -280,10 +287,11 @@ class ContactProblem:
         else:
             keep = self.active_set == "pointwise"
             if u_nodes is None:
-                coupling = MortarCoupling(self.slave, self.master, keep_points=keep)
+                coupling = MortarCoupling(self.slave, self.master, keep_points=keep,
+                                          search_radius=self.search_radius)
             else:  # bases and segmentation in the configuration u (DESIGN.md §2)
                 coupling = MortarCoupling(self.slave.moved(u_nodes), self.master.moved(u_nodes),
-                                          keep_points=keep)
+                                          keep_points=keep, search_radius=self.search_radius)
             reference = self.u.vector.copy() if u_nodes is not None else None
             model = MortarGap(coupling, self.kind, self.penalty, self.scaling, reference)
         self.gap_model = (GlobalGap(model, self.kind, self.penalty, self.scaling)
