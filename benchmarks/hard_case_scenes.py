@@ -572,6 +572,26 @@ def _fit_p0_a(r: np.ndarray, p: np.ndarray) -> tuple[float, float]:
     return float(np.max(p)), float(np.sqrt(-c0 / c1)) if c1 < 0 < c0 else float("nan")
 
 
+def _fit_hertz_profile(r: np.ndarray, p: np.ndarray) -> tuple[float, float]:
+    """p0 and a of the Hertz profile p0 √(1 − r²/a²) fitted (least squares in p)
+    to the nodes with p > 0.
+
+    On unstructured tetrahedra the nodal pressures scatter by up to ±30% from
+    node to node (LmLS*), so the largest one is no estimate of p0, and the fit
+    of p² against r² in :func:`_fit_p0_a` weights the scattered edge nodes
+    most and can lose the slope altogether (a +145% on the a/4 mesh).
+    """
+    from scipy.optimize import least_squares
+    on = p > 0
+    r, p = r[on], p[on]
+
+    def residual(q):
+        return q[0] * np.sqrt(np.maximum(0.0, 1 - (r / q[1]) ** 2)) - p
+
+    fit = least_squares(residual, [np.max(p), 1.05 * np.max(r)])
+    return float(fit.x[0]), float(fit.x[1])
+
+
 def two_cylinders(kind: str, R1: float = 1.0, R2: float = 2.0, force: float = 0.01,
                   refine: float = 0.5) -> dict:
     """Two elastic cylinders (plane strain, same material) against Hertz with
@@ -599,12 +619,26 @@ def two_cylinders(kind: str, R1: float = 1.0, R2: float = 2.0, force: float = 0.
             "dofs": V.dofmap.index_map.size_global * 2}
 
 
-def two_spheres_mesh(R1: float, R2: float, h_contact: float, a: float, comm: MPI.Comm):
+def sphere_gap(r: float, R1: float, R2: float) -> float:
+    """Initial distance between the two spheres at distance r from the axis."""
+    return (R1 - np.sqrt(R1 ** 2 - r ** 2)) + (R2 - np.sqrt(R2 ** 2 - r ** 2))
+
+
+def two_spheres_mesh(R1: float, R2: float, h_contact: float, a: float, comm: MPI.Comm,
+                     cap: Optional[float] = None):
     """Octants: the lower quarter-hemisphere of a sphere R1 about (0,0,R1) above
     the upper quarter-hemisphere of a sphere R2 about (0,0,−R2); symmetry x = 0
     and y = 0. Tags: 1 slave, 2 master, 3 x = 0, 4 y = 0, 5 load z = R1,
-    6 fixed z = −R2."""
+    6 fixed z = −R2, 7 free rest of the upper sphere.
+
+    ``cap``: the slave is only the part of the upper sphere within this
+    distance of the axis (facet midpoints), the rest gets tag 7. A slave
+    reaching where the master falls out of the search radius has partly
+    covered cells there, and the dual kinds' negative lobes turn their large
+    negative gaps into spurious positive nodal gaps (hundreds of times p0).
+    """
     import gmsh
+    from dolfinx import mesh as dmesh
     from dolfinx.io import gmshio
     from dolfinx_mortar.gmsh_io import grade_towards_point
     gmsh.initialize(["", "-v", "0"])
@@ -642,34 +676,52 @@ def two_spheres_mesh(R1: float, R2: float, h_contact: float, a: float, comm: MPI
         domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
     finally:
         gmsh.finalize()
+    if cap is not None:
+        fdim = domain.topology.dim - 1
+        values = tags.values.copy()
+        slave = tags.indices[values == 1]
+        mid = dmesh.compute_midpoints(domain, fdim, slave)
+        values[np.isin(tags.indices, slave[np.linalg.norm(mid[:, :2], axis=1) > cap])] = 7
+        tags = dmesh.meshtags(domain, fdim, tags.indices, values)
     return domain, tags
 
 
 def two_spheres(kind: str, R1: float = 1.0, R2: float = 1.0, force: float = 0.0015,
-                refine: float = 0.5) -> dict:
-    """Two elastic spheres against Hertz with R = R1R2/(R1+R2), E* = E/(2(1−ν²))."""
+                refine: float = 1.0, cap: float = 1.5) -> dict:
+    """Two elastic spheres against Hertz with R = R1R2/(R1+R2), E* = E/(2(1−ν²)).
+
+    The slave is the cap r < ``cap``·a of the upper sphere (the contact zone
+    and a margin), the master the whole lower quarter-hemisphere; the search
+    radius reaches twice the spheres' distance at the cap's edge, so that every
+    slave cell is fully covered (see :func:`two_spheres_mesh`).
+    """
+    import time
     from dolfinx import fem
     from dolfinx_mortar.problem import ContactProblem
+    clock = time.perf_counter()
     E, nu = 1.0, 0.3
     R = R1 * R2 / (R1 + R2)
     E_star = E / (2 * (1 - nu ** 2))
     a = (3 * force * R / (4 * E_star)) ** (1 / 3)
     p0 = 3 * force / (2 * np.pi * a ** 2)
     h = a / (8 * refine)
-    domain, tags = two_spheres_mesh(R1, R2, h, a, MPI.COMM_WORLD)
+    domain, tags = two_spheres_mesh(R1, R2, h, a, MPI.COMM_WORLD, cap=cap * a)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
     problem = ContactProblem(V, tags, 1, master_tag=2, E=E, nu=nu, kind=kind,
                              penalty=1e3 * E / h,
                              fixed={3: {0: 0.0}, 4: {1: 0.0}, 6: {2: 0.0}},
-                             tractions={5: [0.0, 0.0, -force / (np.pi * R1 ** 2)]})
+                             tractions={5: [0.0, 0.0, -force / (np.pi * R1 ** 2)]},
+                             search_radius=2 * sphere_gap(cap * a, R1, R2) + 2 * h)
     result = problem.solve(load_steps=3)
     p = slave_values(problem, problem.nodal_pressures())
     r = np.linalg.norm(slave_coordinates(problem)[:, :2], axis=1)
-    p0_h, a_h = _fit_p0_a(r, p)
+    p0_h, a_h = _fit_hertz_profile(r, p)
     return {"case": "spheres", "kind": kind, "p0_error": p0_h / p0 - 1,
+            "p0_max_error": float(np.max(p)) / p0 - 1,
             "a_error": a_h / a - 1, "newton": result.newton_iterations,
             "force_error": contact_force(problem) / (force / 4) - 1,
-            "dofs": V.dofmap.index_map.size_global * 3}
+            "dofs": V.dofmap.index_map.size_global * 3,
+            "wall_time": time.perf_counter() - clock}
 
 
 # -- pass criteria (shared by the tests and the table) ----------------------------------
@@ -690,7 +742,8 @@ CRITERIA = {
     # zero load, bodies touching at one point: no node may penetrate (beyond 1e-6 h)
     "spurious-gap": [("max_gap_over_h", "<=", 1e-6)],
     "cylinders": [("p0_error_abs", "<=", 0.03), ("a_error_abs", "<=", 0.03)],
-    "spheres": [("p0_error_abs", "<=", 0.15), ("a_error_abs", "<=", 0.10)],
+    # fitted Hertz profile (the largest nodal pressure scatters +31% for LmLS/LmLS*)
+    "spheres": [("p0_error_abs", "<=", 0.06), ("a_error_abs", "<=", 0.06)],
 }
 
 

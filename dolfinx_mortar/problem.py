@@ -169,6 +169,11 @@ class ContactProblem:
         covered part of partly covered slave facets (Popp et al. 2013).
         Without it a dual function that is negative on the covered part turns
         a separated node's gap positive (false penetration).
+    search_radius
+        How far apart slave and master facets may be and still be paired
+        (:class:`MortarCoupling`; default the largest slave facet diameter).
+        A partly covered cell gives the dual kinds spurious positive gaps
+        unless ``boundary_modification`` is on.
     """
 
     def __init__(self, V: fem.FunctionSpace, facet_tags, slave_tag: int, *,
@@ -177,7 +182,8 @@ class ContactProblem:
                  scaling: str = "consistent", active_set: str = "nodal",
                  basis_configuration: str = "initial",
                  fixed: Optional[dict] = None, tractions: Optional[dict] = None,
-                 quadratic_transform: bool = False, boundary_modification: bool = False):
+                 quadratic_transform: bool = False, boundary_modification: bool = False,
+                 search_radius: Optional[float] = None):
         mesh = V.mesh
         gdim = mesh.geometry.dim
         if V.dofmap.index_map_bs != gdim:
@@ -226,6 +232,7 @@ class ContactProblem:
         self.basis_configuration = basis_configuration
         self.active_set = active_set
         self.obstacle = obstacle
+        self.search_radius = search_radius
         self.load = fem.Constant(mesh, PETSc.ScalarType(0.0))
 
         # bulk: small strain, plane strain in 2D
@@ -290,10 +297,11 @@ class ContactProblem:
         else:
             keep = self.active_set == "pointwise"
             if u_nodes is None:
-                coupling = MortarCoupling(self.slave, self.master, keep_points=keep)
+                coupling = MortarCoupling(self.slave, self.master, keep_points=keep,
+                                          search_radius=self.search_radius)
             else:  # bases and segmentation in the configuration u (DESIGN.md §2)
                 coupling = MortarCoupling(self.slave.moved(u_nodes), self.master.moved(u_nodes),
-                                          keep_points=keep)
+                                          keep_points=keep, search_radius=self.search_radius)
             reference = self.u.vector.copy() if u_nodes is not None else None
             model = MortarGap(coupling, self.kind, self.penalty, self.scaling, reference,
                               boundary_modification=self.boundary_modification)

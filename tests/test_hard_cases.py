@@ -163,10 +163,12 @@ def test_two_cylinders_match_hertz(kind):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(run=False, reason="scene not validated: the two-sphere octants of "
-                   "hard_case_scenes.two_spheres give p0 error +392 (LcLS*) and Newton "
-                   "divergence (LmLS): a scene bug is suspected, not diagnosed yet")
 @pytest.mark.parametrize("kind", ALL_KINDS)
 def test_two_spheres_match_hertz(kind):
-    """p0 within 15%, a within 10% (contact size a/4)."""
+    """p0 and a of the fitted Hertz profile within 6% (contact size a/8, ~20 s).
+
+    The slave is a cap r < 1.5a fully covered by the search: the whole
+    quarter-hemisphere had partly covered cells where the master left the
+    search radius, and the dual kinds turned their large negative gaps into
+    positive nodal gaps there (p0 error +392, i.e. ×393)."""
     assert_passes("spheres", scenes.two_spheres(kind))
