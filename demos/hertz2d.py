@@ -46,6 +46,9 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--scaling", default="consistent", choices=("consistent", "seed"))
     parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
                         help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
+    parser.add_argument("--boundary-modification", action="store_true",
+                        help="dual kinds on an elastic master: basis over the covered part "
+                             "of partly covered facets")
     parser.add_argument("--basis-configuration", default="initial",
                         choices=("initial", "previous", "current"),
                         help="configuration of the bases: initial, previous step, current")
@@ -172,6 +175,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
                              penalty=args.penalty * args.E / h_contact, scaling=args.scaling,
                              active_set=args.active_set,
                              basis_configuration=args.basis_configuration,
+                             boundary_modification=args.boundary_modification,
                              fixed=fixed,
                              tractions={LOAD: [0.0, -args.force / (2 * args.radius)]},
                              **kwargs)

@@ -54,6 +54,9 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
     parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
                         help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
+    parser.add_argument("--boundary-modification", action="store_true",
+                        help="dual kinds on an elastic master: basis over the covered part "
+                             "of partly covered facets")
     parser.add_argument("--basis-configuration", default="initial",
                         choices=("initial", "previous", "current"),
                         help="configuration of the bases: initial, previous step, current")
@@ -222,6 +225,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
                              kind=args.kind, penalty=args.penalty * args.E / h_contact,
                              active_set=args.active_set,
                              basis_configuration=args.basis_configuration,
+                             boundary_modification=args.boundary_modification,
                              fixed=fixed, tractions=tractions, **kwargs)
     return problem, {"E_star": E_star, "h_contact": h_contact, "quarter": quarter}
 
