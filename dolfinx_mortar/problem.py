@@ -755,6 +755,46 @@ class ContactProblem:
             p = p1
         return u1, p
 
+    @classmethod
+    def from_two_meshes(cls, mesh_a, facet_tags_a, slave_tag: int, mesh_b, facet_tags_b,
+                        master_tag: int, degree: int = 1, *, tag_offset: int = 0,
+                        shared_tags: Sequence[int] = (), **kwargs) -> "ContactProblem":
+        """The contact of a slave body and an elastic master meshed separately.
+
+        Merges the meshes into one (:func:`dolfinx_mortar.merge_meshes.merge_meshes`:
+        same cell type and geometry degree, any MPI distribution), builds the
+        vector Lagrange space of ``degree`` on it and returns the problem.
+
+        Parameters
+        ----------
+        mesh_a, facet_tags_a, slave_tag
+            The slave body, its facet tags and the tag of its contact facets.
+        mesh_b, facet_tags_b, master_tag
+            The master body, its facet tags and the tag of its contact facets,
+            in mesh_b's own values (shifted by ``tag_offset`` here).
+        degree
+            Degree of the displacement space.
+        tag_offset, shared_tags
+            How b's tag values enter the merged mesh: ``v + tag_offset``,
+            except ``shared_tags`` (kept); see :mod:`dolfinx_mortar.merge_meshes`.
+        **kwargs
+            Passed to :class:`ContactProblem` (``E``, ``nu``, ``penalty``, ...).
+            The keys of ``fixed`` and ``tractions`` are merged tag values.
+
+        The merged facet and cell tags (1 on a's cells, 2 on b's) are kept as
+        ``problem.facet_tags`` and ``problem.cell_tags``.
+        """
+        from dolfinx_mortar.merge_meshes import merge_meshes
+        mesh, facet_tags, cell_tags = merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b,
+                                                   tag_offset=tag_offset,
+                                                   shared_tags=shared_tags)
+        if master_tag not in {int(t) for t in shared_tags}:
+            master_tag = master_tag + tag_offset
+        V = fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
+        problem = cls(V, facet_tags, slave_tag, master_tag=master_tag, **kwargs)
+        problem.facet_tags, problem.cell_tags = facet_tags, cell_tags
+        return problem
+
 
 class AugmentedNewtonStep:
     """Exact Newton step for GLS/GLS* through the sparse augmented system.
