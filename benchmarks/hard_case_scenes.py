@@ -517,6 +517,26 @@ def coincident_patch(kind: str, cell: str = "tetrahedron", mirror_upper: bool = 
 
 
 # -- 7. curved on curved: Hertz with two elastic bodies ----------------------------------
+def _tag_two_bodies(dim: int, upper, lower, flat: list) -> None:
+    """Physical groups of the two curved bodies of the curved-on-curved scenes.
+
+    A boundary entity gets the tag of the first ``(tag, test(centre))`` of
+    ``flat`` that holds, else 1 (upper body: slave) or 2 (lower body: master);
+    the bodies are volumes 10 and 11.
+    """
+    import gmsh
+    groups: dict = {1: [], 2: [], **{tag: [] for tag, _ in flat}}
+    for body, curved in ((upper, 1), (lower, 2)):
+        for _, entity in gmsh.model.getBoundary(body, oriented=False):
+            centre = gmsh.model.occ.getCenterOfMass(dim - 1, entity)
+            tag = next((t for t, holds in flat if holds(centre)), curved)
+            groups[tag].append(entity)
+    for tag, entities in groups.items():
+        gmsh.model.addPhysicalGroup(dim - 1, entities, tag)
+    gmsh.model.addPhysicalGroup(dim, [upper[0][1]], 10)
+    gmsh.model.addPhysicalGroup(dim, [lower[0][1]], 11)
+
+
 def two_cylinders_mesh(R1: float, R2: float, h_contact: float, a: float, comm: MPI.Comm):
     """Quarter of the lower half of a disk R1 about (0, R1) above a quarter of
     the upper half of a disk R2 about (0, −R2); symmetry x = 0.
@@ -536,23 +556,9 @@ def two_cylinders_mesh(R1: float, R2: float, h_contact: float, a: float, comm: M
             lower, _ = occ.intersect([(2, occ.addDisk(0, -R2, 0, R2, R2))],
                                      [(2, occ.addRectangle(0, -R2, 0, R2, R2))])
             occ.synchronize()
-            groups: dict = {k: [] for k in range(1, 6)}
-            tol = 1e-6
-            for body, arc_tag in ((upper, 1), (lower, 2)):
-                for _, curve in gmsh.model.getBoundary(body, oriented=False):
-                    x, y, _ = occ.getCenterOfMass(1, curve)
-                    if abs(x) < tol:
-                        groups[3].append(curve)
-                    elif abs(y - R1) < tol:
-                        groups[4].append(curve)
-                    elif abs(y + R2) < tol:
-                        groups[5].append(curve)
-                    else:
-                        groups[arc_tag].append(curve)
-            for tag, curves in groups.items():
-                gmsh.model.addPhysicalGroup(1, curves, tag)
-            gmsh.model.addPhysicalGroup(2, [upper[0][1]], 10)
-            gmsh.model.addPhysicalGroup(2, [lower[0][1]], 11)
+            _tag_two_bodies(2, upper, lower, [(3, lambda c: abs(c[0]) < 1e-6),
+                                              (4, lambda c: abs(c[1] - R1) < 1e-6),
+                                              (5, lambda c: abs(c[1] + R2) < 1e-6)])
             size_max = min(R1, R2) / 8
             grade_towards_point((0, 0, 0), h_contact, size_max, 1.5 * a,
                                 1.5 * a + 40 * size_max)
@@ -650,25 +656,10 @@ def two_spheres_mesh(R1: float, R2: float, h_contact: float, a: float, comm: MPI
             lower, _ = occ.intersect([(3, occ.addSphere(0, 0, -R2, R2))],
                                      [(3, occ.addBox(0, 0, -R2, R2, R2, R2))])
             occ.synchronize()
-            groups: dict = {k: [] for k in range(1, 7)}
-            tol = 1e-6
-            for body, curved in ((upper, 1), (lower, 2)):
-                for _, s in gmsh.model.getBoundary(body, oriented=False):
-                    x, y, z = occ.getCenterOfMass(2, s)
-                    if abs(x) < tol:
-                        groups[3].append(s)
-                    elif abs(y) < tol:
-                        groups[4].append(s)
-                    elif abs(z - R1) < tol:
-                        groups[5].append(s)
-                    elif abs(z + R2) < tol:
-                        groups[6].append(s)
-                    else:
-                        groups[curved].append(s)
-            for tag, surfaces in groups.items():
-                gmsh.model.addPhysicalGroup(2, surfaces, tag)
-            gmsh.model.addPhysicalGroup(3, [upper[0][1]], 10)
-            gmsh.model.addPhysicalGroup(3, [lower[0][1]], 11)
+            _tag_two_bodies(3, upper, lower, [(3, lambda c: abs(c[0]) < 1e-6),
+                                              (4, lambda c: abs(c[1]) < 1e-6),
+                                              (5, lambda c: abs(c[2] - R1) < 1e-6),
+                                              (6, lambda c: abs(c[2] + R2) < 1e-6)])
             size_max = min(R1, R2) / 5
             grade_towards_point((0, 0, 0), h_contact, size_max, 1.3 * a,
                                 1.3 * a + 12 * size_max)

@@ -30,7 +30,7 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.cli import parse_args_and_petsc_options
+from dolfinx_mortar.cli import add_contact_options, parse_args_and_petsc_options
 from dolfinx_mortar.output import write_json
 
 NAMES = ("slave", "master", "fixed", "load", "sym_x", "sym_y")
@@ -52,14 +52,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--refine", type=float, default=1.0,
                         help="mesh density factor: contact size a/(8·refine) (1)")
     parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
-    parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
-                        help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
-    parser.add_argument("--boundary-modification", action="store_true",
-                        help="dual kinds on an elastic master: basis over the covered part "
-                             "of partly covered facets")
-    parser.add_argument("--basis-configuration", default="initial",
-                        choices=("initial", "previous", "current"),
-                        help="configuration of the bases: initial, previous step, current")
+    add_contact_options(parser)
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"),

@@ -34,3 +34,15 @@ def parse_args_and_petsc_options(parser: argparse.ArgumentParser,
         for key, value in options.items():
             database[key] = value
     return args
+
+
+def add_contact_options(parser: argparse.ArgumentParser) -> None:
+    """The solver options every contact demo offers (see ContactProblem)."""
+    parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
+                        help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
+    parser.add_argument("--boundary-modification", action="store_true",
+                        help="dual kinds on an elastic master: basis over the covered part "
+                             "of partly covered facets")
+    parser.add_argument("--basis-configuration", default="initial",
+                        choices=("initial", "previous", "current"),
+                        help="configuration of the bases: initial, previous step, current")

@@ -22,16 +22,22 @@ def jacobian_error(problem, rng_seed: int = 1) -> float:
     fem.petsc.set_bc(dx, problem.bcs, scale=0.0)
     Jdx = b0.duplicate()
     J.mult(dx, Jdx)
-    h = 1e-6 / dx.norm()
+    fd = residual_difference(problem, x0, dx)
+    fd.axpy(-1.0, Jdx)
+    return fd.norm() / Jdx.norm()
+
+
+def residual_difference(problem, x0, direction, size: float = 1e-6):
+    """(R(x0 + h v) − R(x0 − h v)) / 2h with ‖h v‖ = size: R′(x0)·v."""
+    h = size / direction.norm()
     residuals = []
     for sign in (1, -1):
         x = x0.copy()
-        x.axpy(sign * h, dx)
-        b = b0.duplicate()
+        x.axpy(sign * h, direction)
+        b = problem.b.duplicate()
         problem._residual(None, x, b)
         residuals.append(b)
     fd = residuals[0].copy()
     fd.axpy(-1.0, residuals[1])
     fd.scale(1 / (2 * h))
-    fd.axpy(-1.0, Jdx)
-    return fd.norm() / Jdx.norm()
+    return fd
