@@ -15,14 +15,12 @@ import math
 import resource
 import sys
 import time
-from pathlib import Path
 from typing import Optional, Sequence
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
 from dolfinx_mortar.mortar import MortarCoupling  # noqa: E402

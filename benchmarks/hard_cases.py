@@ -83,7 +83,7 @@ def summary(case: str, row: dict) -> str:
                 f"max|C| {np.nanmin(c):.2g}..{np.nanmax(c):.2g}")
     if case == "penalty":
         return ("pen " + ", ".join(f"{p:.2e}" for p in row["penetration"])
-                + f"; cond J " + ", ".join(f"{c:.1e}" for c in row["cond_J"])
+                + "; cond J " + ", ".join(f"{c:.1e}" for c in row["cond_J"])
                 + f"; Newton {row['newton']}")
     if case == "grazing":
         if not row["converged"]:

@@ -28,7 +28,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.basis import MortarBasis
 from dolfinx_mortar.kinds import (BasisKind, KindLike, is_global, is_partition_of_unity,
-                                  kind_name, parse_kind, unstarred_partner)
+                                  parse_kind, unstarred_partner)
 from dolfinx_mortar.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import MassMatrixSolver, NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar import MortarCoupling

@@ -30,7 +30,7 @@ from dolfinx_mortar import _kernels
 from dolfinx_mortar.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.lagrange import LagrangeSurface
-from dolfinx_mortar.layout import NodeLayout, assemble_blocks
+from dolfinx_mortar.layout import assemble_blocks
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]

@@ -23,7 +23,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_kind
 from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
 from dolfinx_mortar.finite_deformation import CurrentObstacleGap, CurrentState
-from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
+from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, parse_kind
 from dolfinx_mortar.mortar import MortarCoupling
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.obstacles import RigidObstacle

@@ -6,13 +6,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from dolfinx import fem, mesh
+from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
 from jacobian_check import residual_difference
+from meshes import rectangle
 
 DEMOS = Path(__file__).resolve().parent.parent / "demos"
 LOCAL_KINDS = ["LmLS", "LmLS*", "LcLS*", "LcLS"]
@@ -28,17 +29,7 @@ def load(name):
 
 def block_on_plane(comm=MPI.COMM_WORLD, n=(8, 4)):
     """[0,1]x[0,0.5]; tags: 1 bottom (slave), 2 top (load), 3 left (u_x = 0)."""
-    domain = mesh.create_rectangle(comm, [[0, 0], [1, 0.5]], list(n))
-    marks = [(1, lambda x: np.isclose(x[1], 0)), (2, lambda x: np.isclose(x[1], 0.5)),
-             (3, lambda x: np.isclose(x[0], 0) & (x[1] > 1e-9) & (x[1] < 0.5 - 1e-9))]
-    facets, values = [], []
-    for tag, where in marks:
-        f = mesh.locate_entities_boundary(domain, 1, where)
-        facets.append(f)
-        values.append(np.full(len(f), tag, dtype=np.int32))
-    facets, values = np.concatenate(facets), np.concatenate(values)
-    order = np.argsort(facets)
-    tags = mesh.meshtags(domain, 1, facets[order].astype(np.int32), values[order])
+    domain, tags = rectangle(comm, 0.0, 0.5, n, bottom=1, top=2, left=3)
     return fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags
 
 

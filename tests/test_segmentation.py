@@ -6,7 +6,6 @@ import pytest
 from petsc4py import PETSc
 
 from dolfinx_mortar import KIND_NAMES, _kernels
-from dolfinx_mortar.kinds import is_partition_of_unity
 from dolfinx_mortar.lagrange import LagrangeSurface, ReferenceLagrange
 from dolfinx_mortar.mortar import MortarCoupling, to_scipy
 

@@ -14,6 +14,7 @@ from mpi4py import MPI
 
 from dolfinx_mortar.merge_meshes import BODY_A, BODY_B, merge_meshes
 from dolfinx_mortar.problem import ContactProblem
+from meshes import rectangle
 
 ALL_KINDS = ["GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS"]
 # patch test tags (as in demos/patch_test.py); LEFT is one symmetry plane through both
@@ -21,21 +22,6 @@ LOWER_TOP, UPPER_BOTTOM, TOP, BOTTOM, LEFT = 1, 2, 3, 4, 5
 LOWER = dict(y0=-0.5, y1=0.0, bottom=BOTTOM, top=LOWER_TOP, left=LEFT)
 UPPER = dict(y0=0.0, y1=0.5, bottom=UPPER_BOTTOM, top=TOP, left=LEFT)
 PRESSURE = 0.01
-
-
-def rectangle(comm, y0, y1, n, bottom, top, left, cell_type=mesh.CellType.triangle):
-    """[0,1]×[y0,y1] by dolfinx.mesh.create_rectangle, with bottom/top/left facet tags."""
-    domain = mesh.create_rectangle(comm, [[0, y0], [1, y1]], list(n), cell_type=cell_type)
-    marks = [(bottom, lambda x: np.isclose(x[1], y0)), (top, lambda x: np.isclose(x[1], y1)),
-             (left, lambda x: np.isclose(x[0], 0))]
-    facets, values = [], []
-    for tag, where in marks:
-        f = mesh.locate_entities_boundary(domain, 1, where)
-        facets.append(f)
-        values.append(np.full(len(f), tag, dtype=np.int32))
-    facets, values = np.concatenate(facets), np.concatenate(values)
-    order = np.argsort(facets)
-    return domain, mesh.meshtags(domain, 1, facets[order].astype(np.int32), values[order])
 
 
 def gmsh_blocks(comm, blocks, degree=1):
