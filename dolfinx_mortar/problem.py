@@ -8,6 +8,7 @@ that are cut back when Newton fails, and XDMF output after every converged step.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional, Sequence, Union
@@ -214,6 +215,12 @@ class ContactProblem:
             raise ValueError("the consistent boundary modification applies to the dual kinds "
                              "(LcLS*, LcLS) with an elastic master (master_tag)")
         self.boundary_modification = boundary_modification
+        if active_set == "pointwise" and parse_kind(kind) in (BasisKind.LcLS_star,
+                                                              BasisKind.LcLS):
+            warnings.warn("the pointwise active set with a dual kind: ∫M̄_A⟨d⟩ is negative "
+                          "next to the contact edge, and Newton did not converge on any "
+                          "curved contact tested (Hertz 2D); prefer active_set='nodal'",
+                          RuntimeWarning, stacklevel=2)
         fixed, tractions = fixed or {}, tractions or {}
         present = {int(t) for values in mesh.comm.allgather(np.unique(facet_tags.values))
                    for t in values}

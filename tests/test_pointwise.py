@@ -12,6 +12,9 @@ from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
 from jacobian_check import jacobian_error
 from test_problem import ALL_KINDS, block_on_plane, load
 
+# dual kinds appear here on purpose; the warning itself is tested at the end
+pytestmark = pytest.mark.filterwarnings("ignore:the pointwise active set with a dual kind")
+
 
 @pytest.mark.parametrize("cell, gap, area", [
     ("interval", lambda X: 0.3 - X[:, 0], 0.3),
@@ -114,3 +117,10 @@ def test_pointwise_newton_converges_on_hertz2d(kind):
                                     "pointwise", "--load-steps", "4"])
     assert abs(figures["force_error"]) < 1e-8
     assert abs(figures["p0_error"]) < 0.02
+
+
+def test_pointwise_with_a_dual_kind_warns():
+    V, tags = block_on_plane()
+    with pytest.warns(RuntimeWarning, match="prefer active_set='nodal'"):
+        ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
+                       kind="dual", penalty=10.0, active_set="pointwise")
