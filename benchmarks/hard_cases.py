@@ -21,8 +21,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import hard_case_scenes as scenes  # noqa: E402
 
 K = scenes.ALL_KINDS
-CASES = ("sweep", "quadratic", "ratio", "penalty", "grazing", "coincident", "spurious-gap",
-         "cylinders", "spheres")
+CASES = ("sweep", "sweep-elastic", "quadratic", "ratio", "penalty", "grazing", "coincident",
+         "spurious-gap", "cylinders", "spheres")
 SLOW = ("spheres",)
 #: kinds not run for a case (with the reason printed in the table)
 NOT_RUN: dict = {}
@@ -37,6 +37,12 @@ def rows_of(case: str):
             yield "sweep-contact-block", v, r
             if r["boundary_modification"]:
                 yield "sweep-modified-coefficients", v, r
+    elif case == "sweep-elastic":
+        for kind, modified in [(k, False) for k in K] + [(k, True) for k in scenes.DUAL_KINDS]:
+            r = scenes.elastic_sweep(kind, modified)
+            v = "modified" if modified else "plain"
+            yield "sweep-elastic", v, r
+            yield "sweep-elastic-pressure", v, r
     elif case == "quadratic":
         for kind in K:
             for v in ("P2-triangle", "Q8", "Q9"):
@@ -76,6 +82,10 @@ def summary(case: str, row: dict) -> str:
     """A few key numbers of a row for the printed table."""
     if row.get("skipped"):
         return ""
+    if case.startswith("sweep-elastic"):
+        return ("cond J " + ", ".join(f"{c:.2e}" for c in row["cond_J"])
+                + "; max|p|/median p " + ", ".join(f"{r:.3g}" for r in row["p_ratio"])
+                + f" (slivers {row['slivers']})")
     if case.startswith("sweep"):
         cJ, cD = row["cond_J"], row["cond_D"]
         c = np.asarray(row["max_coefficient"])
