@@ -758,20 +758,61 @@ def sliver_blocks(sliver: float, comm: MPI.Comm, h: float = 0.1):
     return domain, tags
 
 
-def elastic_sweep(kind: str, modification: bool, slivers=SLIVERS) -> dict:
+def sliver_boxes(sliver: float, comm: MPI.Comm, h: float = 0.2):
+    """3D version of :func:`sliver_blocks`: a structured lower box [0,1]²×[−½,0]
+    (slave nodes every h on its top) and an upper box [x0, 0.9]×[0,1]×[GAP, ½]
+    with x0 = 0.4 − sliver·h. Same tags."""
+    import gmsh
+    from dolfinx.io import gmshio
+    gmsh.initialize(["", "-v", "0"])
+    try:
+        if comm.rank == 0:
+            occ = gmsh.model.occ
+            lower = occ.addBox(0, 0, -0.5, 1, 1, 0.5)
+            x0 = 0.4 - sliver * h
+            upper = occ.addBox(x0, 0, SLIVER_GAP, 0.9 - x0, 1, 0.5 - SLIVER_GAP)
+            occ.synchronize()
+            # structured triangles on the slave face only: its nodes every h
+            for _, f in gmsh.model.getBoundary([(3, lower)], oriented=False):
+                if abs(occ.getCenterOfMass(2, f)[2]) < 1e-9:
+                    for _, c in gmsh.model.getBoundary([(2, f)], oriented=False):
+                        gmsh.model.mesh.setTransfiniteCurve(c, round(1 / h) + 1)
+                    gmsh.model.mesh.setTransfiniteSurface(f)
+            groups: dict = {k: [] for k in range(1, 5)}
+            for body in (lower, upper):
+                for _, f in gmsh.model.getBoundary([(3, body)], oriented=False):
+                    _, _, z = occ.getCenterOfMass(2, f)
+                    for tag, level in ((1, 0.0), (2, SLIVER_GAP), (3, -0.5), (4, 0.5)):
+                        if abs(z - level) < 1e-9:
+                            groups[tag].append(f)
+            for tag, faces in groups.items():
+                gmsh.model.addPhysicalGroup(2, faces, tag)
+            gmsh.model.addPhysicalGroup(3, [lower], 11)
+            gmsh.model.addPhysicalGroup(3, [upper], 12)
+            gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.27)
+            gmsh.model.mesh.generate(3)
+        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
+    finally:
+        gmsh.finalize()
+    return domain, tags
+
+
+def elastic_sweep(kind: str, modification: bool, slivers=SLIVERS, dim: int = 2) -> dict:
     """cond of the Newton matrix at the solution while the master's edge leaves
     a sliver·h of a slave facet covered (upper block pressed 1.5·GAP down)."""
     from dolfinx import fem
     from dolfinx_mortar.problem import ContactProblem
-    out = {"case": "sweep-elastic", "kind": kind, "modified": modification,
+    out = {"case": "sweep-elastic", "kind": kind, "modified": modification, "dim": dim,
            "slivers": list(slivers), "cond_J": [], "newton": [], "p_ratio": []}
     for sliver in slivers:
-        domain, tags = sliver_blocks(sliver, MPI.COMM_WORLD)
+        build, h = (sliver_blocks, 0.1) if dim == 2 else (sliver_boxes, 0.2)
+        domain, tags = build(sliver, MPI.COMM_WORLD)
         V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+        down = {k: 0.0 for k in range(dim - 1)}
         problem = ContactProblem(V, tags, 1, master_tag=2, E=1.0, nu=0.3, kind=kind,
-                                 penalty=1e3 / 0.1, boundary_modification=modification,
-                                 fixed={3: {0: 0.0, 1: 0.0},
-                                        4: {0: 0.0, 1: -1.5 * SLIVER_GAP}})
+                                 penalty=1e3 / h, boundary_modification=modification,
+                                 fixed={3: {k: 0.0 for k in range(dim)},
+                                        4: {**down, dim - 1: -1.5 * SLIVER_GAP}})
         result = problem.solve(load_steps=1)
         out["newton"].append(result.newton_iterations)
         A, free = newton_matrix(problem)

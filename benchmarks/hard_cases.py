@@ -38,11 +38,13 @@ def rows_of(case: str):
             if r["boundary_modification"]:
                 yield "sweep-modified-coefficients", v, r
     elif case == "sweep-elastic":
-        for kind, modified in [(k, False) for k in K] + [(k, True) for k in scenes.DUAL_KINDS]:
-            r = scenes.elastic_sweep(kind, modified)
-            v = "modified" if modified else "plain"
-            yield "sweep-elastic", v, r
-            yield "sweep-elastic-pressure", v, r
+        for dim in (2, 3):
+            for kind, modified in ([(k, False) for k in K]
+                                   + [(k, True) for k in scenes.DUAL_KINDS]):
+                r = scenes.elastic_sweep(kind, modified, dim=dim)
+                v = f"{dim}D " + ("modified" if modified else "plain")
+                yield "sweep-elastic", v, r
+                yield "sweep-elastic-pressure", v, r
     elif case == "quadratic":
         for kind in K:
             for v in ("P2-triangle", "Q8", "Q9"):
