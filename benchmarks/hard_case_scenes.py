@@ -67,6 +67,22 @@ def gather_sparse(mat: PETSc.Mat):
     return scipy.sparse.csr_matrix((v, (r, c)), shape=mat.getSize())
 
 
+def gmsh_mesh(comm: MPI.Comm, dim: int, build):
+    """A DOLFINx mesh and facet tags from a gmsh model that ``build()`` makes on
+    rank 0 (geometry, physical groups, sizes); meshed in ``dim`` dimensions."""
+    import gmsh
+    from dolfinx.io import gmshio
+    gmsh.initialize(["", "-v", "0"])
+    try:
+        if comm.rank == 0:
+            build()
+            gmsh.model.mesh.generate(dim)
+        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=dim)
+    finally:
+        gmsh.finalize()
+    return domain, tags
+
+
 def newton_matrix(problem):
     """Newton matrix (SciPy sparse, on every rank) at the current u, and the
     mask of its free dofs.
@@ -361,38 +377,34 @@ def disk_with_neck_mesh(R: float, h_contact: float, comm: MPI.Comm):
     Tags: 1 the arc (slave), 2 the top y = 1.5R, 3 the left side x = −R.
     """
     import gmsh
-    from dolfinx.io import gmshio
     from dolfinx_mortar.gmsh_io import grade_towards_point
-    gmsh.initialize(["", "-v", "0"])
-    try:
-        if comm.rank == 0:
-            occ = gmsh.model.occ
-            # two arcs meeting at the touching point, then the neck
-            p = [occ.addPoint(*q, 0.0) for q in ((-R, R), (0, 0), (R, R), (R, 1.5 * R),
-                                                 (-R, 1.5 * R))]
-            centre = occ.addPoint(0.0, R, 0.0)
-            curves = [occ.addCircleArc(p[0], centre, p[1]), occ.addCircleArc(p[1], centre, p[2]),
-                      occ.addLine(p[2], p[3]), occ.addLine(p[3], p[4]), occ.addLine(p[4], p[0])]
-            body = [(2, occ.addPlaneSurface([occ.addCurveLoop(curves)]))]
-            occ.synchronize()
-            groups: dict = {1: [], 2: [], 3: []}
-            for _, curve in gmsh.model.getBoundary(body, oriented=False):
-                x, y, _ = occ.getCenterOfMass(1, curve)
-                if abs(y - 1.5 * R) < 1e-6 * R:
-                    groups[2].append(curve)
-                elif abs(x + R) < 1e-6 * R and y > R:
-                    groups[3].append(curve)
-                elif y < R - 1e-6 * R:
-                    groups[1].append(curve)
-            for tag, curves in groups.items():
-                gmsh.model.addPhysicalGroup(1, curves, tag)
-            gmsh.model.addPhysicalGroup(2, [body[0][1]], 10)
-            grade_towards_point((0.0, 0.0, 0.0), h_contact, R / 6, 0.15 * R,
-                                0.15 * R + 30 * R / 6)
-            gmsh.model.mesh.generate(2)
-        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    finally:
-        gmsh.finalize()
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        # two arcs meeting at the touching point, then the neck
+        p = [occ.addPoint(*q, 0.0) for q in ((-R, R), (0, 0), (R, R), (R, 1.5 * R),
+                                             (-R, 1.5 * R))]
+        centre = occ.addPoint(0.0, R, 0.0)
+        curves = [occ.addCircleArc(p[0], centre, p[1]), occ.addCircleArc(p[1], centre, p[2]),
+                  occ.addLine(p[2], p[3]), occ.addLine(p[3], p[4]), occ.addLine(p[4], p[0])]
+        body = [(2, occ.addPlaneSurface([occ.addCurveLoop(curves)]))]
+        occ.synchronize()
+        groups: dict = {1: [], 2: [], 3: []}
+        for _, curve in gmsh.model.getBoundary(body, oriented=False):
+            x, y, _ = occ.getCenterOfMass(1, curve)
+            if abs(y - 1.5 * R) < 1e-6 * R:
+                groups[2].append(curve)
+            elif abs(x + R) < 1e-6 * R and y > R:
+                groups[3].append(curve)
+            elif y < R - 1e-6 * R:
+                groups[1].append(curve)
+        for tag, curves in groups.items():
+            gmsh.model.addPhysicalGroup(1, curves, tag)
+        gmsh.model.addPhysicalGroup(2, [body[0][1]], 10)
+        grade_towards_point((0.0, 0.0, 0.0), h_contact, R / 6, 0.15 * R,
+                            0.15 * R + 30 * R / 6)
+
+    domain, tags = gmsh_mesh(comm, 2, build)
     return domain, tags
 
 
@@ -545,27 +557,23 @@ def two_cylinders_mesh(R1: float, R2: float, h_contact: float, a: float, comm: M
     5 fixed y = −R2.
     """
     import gmsh
-    from dolfinx.io import gmshio
     from dolfinx_mortar.gmsh_io import grade_towards_point
-    gmsh.initialize(["", "-v", "0"])
-    try:
-        if comm.rank == 0:
-            occ = gmsh.model.occ
-            upper, _ = occ.intersect([(2, occ.addDisk(0, R1, 0, R1, R1))],
-                                     [(2, occ.addRectangle(0, 0, 0, R1, R1))])
-            lower, _ = occ.intersect([(2, occ.addDisk(0, -R2, 0, R2, R2))],
-                                     [(2, occ.addRectangle(0, -R2, 0, R2, R2))])
-            occ.synchronize()
-            _tag_two_bodies(2, upper, lower, [(3, lambda c: abs(c[0]) < 1e-6),
-                                              (4, lambda c: abs(c[1] - R1) < 1e-6),
-                                              (5, lambda c: abs(c[1] + R2) < 1e-6)])
-            size_max = min(R1, R2) / 8
-            grade_towards_point((0, 0, 0), h_contact, size_max, 1.5 * a,
-                                1.5 * a + 40 * size_max)
-            gmsh.model.mesh.generate(2)
-        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    finally:
-        gmsh.finalize()
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        upper, _ = occ.intersect([(2, occ.addDisk(0, R1, 0, R1, R1))],
+                                 [(2, occ.addRectangle(0, 0, 0, R1, R1))])
+        lower, _ = occ.intersect([(2, occ.addDisk(0, -R2, 0, R2, R2))],
+                                 [(2, occ.addRectangle(0, -R2, 0, R2, R2))])
+        occ.synchronize()
+        _tag_two_bodies(2, upper, lower, [(3, lambda c: abs(c[0]) < 1e-6),
+                                          (4, lambda c: abs(c[1] - R1) < 1e-6),
+                                          (5, lambda c: abs(c[1] + R2) < 1e-6)])
+        size_max = min(R1, R2) / 8
+        grade_towards_point((0, 0, 0), h_contact, size_max, 1.5 * a,
+                            1.5 * a + 40 * size_max)
+
+    domain, tags = gmsh_mesh(comm, 2, build)
     return domain, tags
 
 
@@ -645,28 +653,24 @@ def two_spheres_mesh(R1: float, R2: float, h_contact: float, a: float, comm: MPI
     """
     import gmsh
     from dolfinx import mesh as dmesh
-    from dolfinx.io import gmshio
     from dolfinx_mortar.gmsh_io import grade_towards_point
-    gmsh.initialize(["", "-v", "0"])
-    try:
-        if comm.rank == 0:
-            occ = gmsh.model.occ
-            upper, _ = occ.intersect([(3, occ.addSphere(0, 0, R1, R1))],
-                                     [(3, occ.addBox(0, 0, 0, R1, R1, R1))])
-            lower, _ = occ.intersect([(3, occ.addSphere(0, 0, -R2, R2))],
-                                     [(3, occ.addBox(0, 0, -R2, R2, R2, R2))])
-            occ.synchronize()
-            _tag_two_bodies(3, upper, lower, [(3, lambda c: abs(c[0]) < 1e-6),
-                                              (4, lambda c: abs(c[1]) < 1e-6),
-                                              (5, lambda c: abs(c[2] - R1) < 1e-6),
-                                              (6, lambda c: abs(c[2] + R2) < 1e-6)])
-            size_max = min(R1, R2) / 5
-            grade_towards_point((0, 0, 0), h_contact, size_max, 1.3 * a,
-                                1.3 * a + 12 * size_max)
-            gmsh.model.mesh.generate(3)
-        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
-    finally:
-        gmsh.finalize()
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        upper, _ = occ.intersect([(3, occ.addSphere(0, 0, R1, R1))],
+                                 [(3, occ.addBox(0, 0, 0, R1, R1, R1))])
+        lower, _ = occ.intersect([(3, occ.addSphere(0, 0, -R2, R2))],
+                                 [(3, occ.addBox(0, 0, -R2, R2, R2, R2))])
+        occ.synchronize()
+        _tag_two_bodies(3, upper, lower, [(3, lambda c: abs(c[0]) < 1e-6),
+                                          (4, lambda c: abs(c[1]) < 1e-6),
+                                          (5, lambda c: abs(c[2] - R1) < 1e-6),
+                                          (6, lambda c: abs(c[2] + R2) < 1e-6)])
+        size_max = min(R1, R2) / 5
+        grade_towards_point((0, 0, 0), h_contact, size_max, 1.3 * a,
+                            1.3 * a + 12 * size_max)
+
+    domain, tags = gmsh_mesh(comm, 3, build)
     if cap is not None:
         fdim = domain.topology.dim - 1
         values = tags.values.copy()
@@ -726,35 +730,31 @@ def sliver_blocks(sliver: float, comm: MPI.Comm, h: float = 0.1):
     x0 = 0.4 − sliver·h: the slave facet [0.3, 0.4] is covered over a length
     sliver·h. Tags: 1 slave, 2 master, 3 lower bottom, 4 upper top."""
     import gmsh
-    from dolfinx.io import gmshio
-    gmsh.initialize(["", "-v", "0"])
-    try:
-        if comm.rank == 0:
-            occ = gmsh.model.occ
-            lower = occ.addRectangle(0, -0.5, 0, 1, 0.5)
-            x0 = 0.4 - sliver * h
-            upper = occ.addRectangle(x0, SLIVER_GAP, 0, 0.9 - x0, 0.5 - SLIVER_GAP)
-            occ.synchronize()
-            groups: dict = {k: [] for k in range(1, 5)}
-            for body in (lower, upper):
-                for _, c in gmsh.model.getBoundary([(2, body)], oriented=False):
-                    _, y, _ = occ.getCenterOfMass(1, c)
-                    for tag, level in ((1, 0.0), (2, SLIVER_GAP), (3, -0.5), (4, 0.5)):
-                        if abs(y - level) < 1e-9:
-                            groups[tag].append(c)
-                    if body == lower:   # the slave nodes every h along the top
-                        n = round(1 / h) + 1 if abs(abs(y) - 0.25) > 0.2 else round(0.5 / h) + 1
-                        gmsh.model.mesh.setTransfiniteCurve(c, n)
-            gmsh.model.mesh.setTransfiniteSurface(lower)
-            for tag, curves in groups.items():
-                gmsh.model.addPhysicalGroup(1, curves, tag)
-            gmsh.model.addPhysicalGroup(2, [lower], 11)
-            gmsh.model.addPhysicalGroup(2, [upper], 12)
-            gmsh.model.mesh.setSize(gmsh.model.getBoundary([(2, upper)], recursive=True), 0.13)
-            gmsh.model.mesh.generate(2)
-        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    finally:
-        gmsh.finalize()
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        lower = occ.addRectangle(0, -0.5, 0, 1, 0.5)
+        x0 = 0.4 - sliver * h
+        upper = occ.addRectangle(x0, SLIVER_GAP, 0, 0.9 - x0, 0.5 - SLIVER_GAP)
+        occ.synchronize()
+        groups: dict = {k: [] for k in range(1, 5)}
+        for body in (lower, upper):
+            for _, c in gmsh.model.getBoundary([(2, body)], oriented=False):
+                _, y, _ = occ.getCenterOfMass(1, c)
+                for tag, level in ((1, 0.0), (2, SLIVER_GAP), (3, -0.5), (4, 0.5)):
+                    if abs(y - level) < 1e-9:
+                        groups[tag].append(c)
+                if body == lower:   # the slave nodes every h along the top
+                    n = round(1 / h) + 1 if abs(abs(y) - 0.25) > 0.2 else round(0.5 / h) + 1
+                    gmsh.model.mesh.setTransfiniteCurve(c, n)
+        gmsh.model.mesh.setTransfiniteSurface(lower)
+        for tag, curves in groups.items():
+            gmsh.model.addPhysicalGroup(1, curves, tag)
+        gmsh.model.addPhysicalGroup(2, [lower], 11)
+        gmsh.model.addPhysicalGroup(2, [upper], 12)
+        gmsh.model.mesh.setSize(gmsh.model.getBoundary([(2, upper)], recursive=True), 0.13)
+
+    domain, tags = gmsh_mesh(comm, 2, build)
     return domain, tags
 
 
@@ -763,37 +763,33 @@ def sliver_boxes(sliver: float, comm: MPI.Comm, h: float = 0.2):
     (slave nodes every h on its top) and an upper box [x0, 0.9]×[0,1]×[GAP, ½]
     with x0 = 0.4 − sliver·h. Same tags."""
     import gmsh
-    from dolfinx.io import gmshio
-    gmsh.initialize(["", "-v", "0"])
-    try:
-        if comm.rank == 0:
-            occ = gmsh.model.occ
-            lower = occ.addBox(0, 0, -0.5, 1, 1, 0.5)
-            x0 = 0.4 - sliver * h
-            upper = occ.addBox(x0, 0, SLIVER_GAP, 0.9 - x0, 1, 0.5 - SLIVER_GAP)
-            occ.synchronize()
-            # structured triangles on the slave face only: its nodes every h
-            for _, f in gmsh.model.getBoundary([(3, lower)], oriented=False):
-                if abs(occ.getCenterOfMass(2, f)[2]) < 1e-9:
-                    for _, c in gmsh.model.getBoundary([(2, f)], oriented=False):
-                        gmsh.model.mesh.setTransfiniteCurve(c, round(1 / h) + 1)
-                    gmsh.model.mesh.setTransfiniteSurface(f)
-            groups: dict = {k: [] for k in range(1, 5)}
-            for body in (lower, upper):
-                for _, f in gmsh.model.getBoundary([(3, body)], oriented=False):
-                    _, _, z = occ.getCenterOfMass(2, f)
-                    for tag, level in ((1, 0.0), (2, SLIVER_GAP), (3, -0.5), (4, 0.5)):
-                        if abs(z - level) < 1e-9:
-                            groups[tag].append(f)
-            for tag, faces in groups.items():
-                gmsh.model.addPhysicalGroup(2, faces, tag)
-            gmsh.model.addPhysicalGroup(3, [lower], 11)
-            gmsh.model.addPhysicalGroup(3, [upper], 12)
-            gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.27)
-            gmsh.model.mesh.generate(3)
-        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
-    finally:
-        gmsh.finalize()
+
+    def build() -> None:
+        occ = gmsh.model.occ
+        lower = occ.addBox(0, 0, -0.5, 1, 1, 0.5)
+        x0 = 0.4 - sliver * h
+        upper = occ.addBox(x0, 0, SLIVER_GAP, 0.9 - x0, 1, 0.5 - SLIVER_GAP)
+        occ.synchronize()
+        # structured triangles on the slave face only: its nodes every h
+        for _, f in gmsh.model.getBoundary([(3, lower)], oriented=False):
+            if abs(occ.getCenterOfMass(2, f)[2]) < 1e-9:
+                for _, c in gmsh.model.getBoundary([(2, f)], oriented=False):
+                    gmsh.model.mesh.setTransfiniteCurve(c, round(1 / h) + 1)
+                gmsh.model.mesh.setTransfiniteSurface(f)
+        groups: dict = {k: [] for k in range(1, 5)}
+        for body in (lower, upper):
+            for _, f in gmsh.model.getBoundary([(3, body)], oriented=False):
+                _, _, z = occ.getCenterOfMass(2, f)
+                for tag, level in ((1, 0.0), (2, SLIVER_GAP), (3, -0.5), (4, 0.5)):
+                    if abs(z - level) < 1e-9:
+                        groups[tag].append(f)
+        for tag, faces in groups.items():
+            gmsh.model.addPhysicalGroup(2, faces, tag)
+        gmsh.model.addPhysicalGroup(3, [lower], 11)
+        gmsh.model.addPhysicalGroup(3, [upper], 12)
+        gmsh.model.mesh.setSize(gmsh.model.getEntities(0), 0.27)
+
+    domain, tags = gmsh_mesh(comm, 3, build)
     return domain, tags
 
 
