@@ -22,20 +22,16 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.cli import add_contact_options, parse_args_and_petsc_options
+from dolfinx_mortar.cli import (add_contact_options, parse_args_and_petsc_options,
+                                solver_demo_parser)
 from dolfinx_mortar.output import write_json
 
 SLAVE, MASTER, SYMMETRY, LOAD, FIXED = 1, 2, 3, 4, 5
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0],
-        epilog="PETSc options (single dash) go to the options database, e.g. "
-               "-dolfinx_mortar_snes_monitor -dolfinx_mortar_snes_linesearch_type bt")
+    parser = solver_demo_parser(__doc__)
     parser.add_argument("--radius", type=float, default=1.0, help="cylinder radius R (1)")
-    parser.add_argument("--E", type=float, default=1.0, help="Young's modulus (1)")
-    parser.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
     parser.add_argument("--force", type=float, default=0.01,
                         help="line load F per unit thickness (0.01: a ≈ 0.11 R)")
     parser.add_argument("--refine", type=float, default=1.0,

@@ -30,7 +30,8 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.cli import add_contact_options, parse_args_and_petsc_options
+from dolfinx_mortar.cli import (add_contact_options, parse_args_and_petsc_options,
+                                solver_demo_parser)
 from dolfinx_mortar.output import write_json
 
 NAMES = ("slave", "master", "fixed", "load", "sym_x", "sym_y")
@@ -38,13 +39,8 @@ SLAVE, MASTER, FIXED, LOAD, SYM_X, SYM_Y = range(1, 7)
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0],
-        epilog="PETSc options (single dash) go to the options database, e.g. "
-               "-dolfinx_mortar_snes_monitor -dolfinx_mortar_snes_linesearch_type bt")
+    parser = solver_demo_parser(__doc__)
     parser.add_argument("--radius", type=float, default=1.0, help="sphere radius R (1)")
-    parser.add_argument("--E", type=float, default=1.0, help="Young's modulus (1)")
-    parser.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
     parser.add_argument("--force", type=float, default=0.0015,
                         help="total force F on the whole sphere (0.0015: a ≈ 0.1 R)")
     parser.add_argument("--load-displacement", type=float, default=None,

@@ -17,7 +17,7 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.cli import parse_args_and_petsc_options
+from dolfinx_mortar.cli import parse_args_and_petsc_options, solver_demo_parser
 from dolfinx_mortar.output import write_json
 
 LOWER_TOP, UPPER_BOTTOM, TOP, BOTTOM, SYM_X, SYM_Y = 1, 2, 3, 4, 5, 6
@@ -25,10 +25,7 @@ ALL_KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0],
-        epilog="PETSc options (single dash) go to the options database, e.g. "
-               "-dolfinx_mortar_snes_monitor -dolfinx_mortar_snes_linesearch_type bt")
+    parser = solver_demo_parser(__doc__)
     parser.add_argument("--dim", type=int, default=2, choices=(2, 3))
     parser.add_argument("--degree", type=int, default=1, choices=(1, 2))
     parser.add_argument("--fine", type=float, default=0.09, help="finer element size (0.09)")
@@ -40,8 +37,6 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
                         help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
     parser.add_argument("--pressure", type=float, default=0.01, help="applied pressure (0.01)")
-    parser.add_argument("--E", type=float, default=1.0)
-    parser.add_argument("--nu", type=float, default=0.3)
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="ε as a multiple of E / fine size (1e3)")
     parser.add_argument("--json", default=None, help="write the results as JSON here")

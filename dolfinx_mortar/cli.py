@@ -46,3 +46,15 @@ def add_contact_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--basis-configuration", default="initial",
                         choices=("initial", "previous", "current"),
                         help="configuration of the bases: initial, previous step, current")
+
+
+def solver_demo_parser(doc: str) -> argparse.ArgumentParser:
+    """The parser of a contact demo: its docstring's first paragraph, a note on
+    PETSc options, and the material (--E, --nu)."""
+    parser = argparse.ArgumentParser(
+        description=doc.split("\n\n")[0],
+        epilog="PETSc options (single dash) go to the options database, e.g. "
+               "-dolfinx_mortar_snes_monitor -dolfinx_mortar_snes_linesearch_type bt")
+    parser.add_argument("--E", type=float, default=1.0, help="Young's modulus (1)")
+    parser.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (0.3)")
+    return parser

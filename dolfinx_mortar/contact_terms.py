@@ -194,7 +194,7 @@ class MortarGap(_GapBase):
             C = coupling._covered_coefficients(self.basis.kind)
             T = self.slave.reference.transform
             self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
-            _, _, W_cov = covered_element_mass(coupling)
+            _, _, W_cov = coupling.covered_element_mass()
             self._weights_source = W_cov
             if scaling == "consistent":
                 self.weights = self.penalty * W_cov
@@ -237,26 +237,12 @@ class MortarGap(_GapBase):
         return self.gaps0 + self.slave.layout.to_local(Gu)
 
 
-def covered_element_mass(coupling: MortarCoupling
-                         ) -> tuple[FloatArray, npt.NDArray[np.int64], FloatArray]:
-    """Element matrices ``∫_cov N_A N_B`` of every slave cell, the covered cells,
-    and the nodal ``W_A = ∫_cov N_A`` (summed over ranks)."""
-    slave = coupling.slave
-    nd = slave.cells.shape[1]
-    covered_cells = np.unique(coupling.pairs[:, 0])
-    L = np.zeros((len(slave.cells), nd, nd))
-    np.add.at(L, coupling.pairs[:, 0], coupling.D_pairs)
-    W = slave.layout.sum_at_functions(slave.cells[covered_cells],
-                                      L[covered_cells].sum(axis=2))
-    return L, covered_cells, W
-
-
 def covered_mass(coupling: MortarCoupling) -> tuple[MassMatrixSolver, FloatArray]:
     """``L_AB = ∫_cov N_A N_B`` over the covered slave area, factorized, and its
     row sums ``W_A = ∫_cov N_A``. Nodes with no covered support get a unit row
     (their gap is 0 and their weight 0)."""
     slave = coupling.slave
-    L, covered_cells, W = covered_element_mass(coupling)
+    L, covered_cells, W = coupling.covered_element_mass()
     matrix = slave.layout.assemble_matrix(slave.cells[covered_cells], L[covered_cells])
     return MassMatrixSolver(slave.layout, matrix), W
 

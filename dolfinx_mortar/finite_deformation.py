@@ -165,15 +165,11 @@ class CurrentObstacleGap(_GapBase):
         cells, layout = self.slave.cells, self.slave.layout
         nc, nd = cells.shape
         gdim = self.slave.gdim
-        w = self.wq[None, :]
-        g_c = np.einsum("cq,qa->ca", w * e["J"] * e["d"], self.phi)
-        W_c = np.einsum("cq,qa->ca", w * e["J"], self.N)
+        g, W = self._nodal_sums(e)
         v = np.einsum("cqi,qb->cqbi", e["grad"], self.N)             # ∇d_i N_b
         dg_c = (np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["d"], e["dJ"])
                 + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["J"], v))
         dW_c = np.einsum("q,qa,cqbi->cabi", self.wq, self.N, e["dJ"])
-        g = layout.sum_at_functions(cells, g_c)
-        W = layout.sum_at_functions(cells, W_c)
         cols = self._node_dofs(cells).reshape(nc, nd * gdim)
         G_g = assemble_blocks(layout, cells, self.dofs, cols, dg_c.reshape(nc, nd, nd * gdim))
         G_W = assemble_blocks(layout, cells, self.dofs, cols, dW_c.reshape(nc, nd, nd * gdim))
@@ -252,19 +248,21 @@ class CurrentObstacleGap(_GapBase):
         K.axpy(1.0, K_el, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return K
 
+    def _nodal_sums(self, e: dict) -> tuple[FloatArray, FloatArray]:
+        """ĝ_A = ∫ φ_A d da and W_A = ∫ N_A da on the current surface (all ranks)."""
+        cells, layout = self.slave.cells, self.slave.layout
+        wJ = self.wq[None, :] * e["J"]
+        return (layout.sum_at_functions(cells, np.einsum("cq,qa->ca", wJ * e["d"], self.phi)),
+                layout.sum_at_functions(cells, np.einsum("cq,qa->ca", wJ, self.N)))
+
     def energy(self, u_nodes: FloatArray) -> float:
         """Π_c summed over all ranks (for checking the residual)."""
-        e = self._elements(u_nodes)
-        cells, layout = self.slave.cells, self.slave.layout
-        w = self.wq[None, :]
-        g = layout.sum_at_functions(cells, np.einsum("cq,qa->ca", w * e["J"] * e["d"],
-                                                     self.phi))
-        W = layout.sum_at_functions(cells, np.einsum("cq,qa->ca", w * e["J"], self.N))
+        g, W = self._nodal_sums(self._elements(u_nodes))
         Wsafe = np.where(W > 0, W, 1.0)
         y = g * Wsafe ** (-self.k)
-        n = layout.num_owned
+        n = self.slave.layout.num_owned
         local = 0.5 * self.penalty * np.sum((Wsafe ** self.m * np.maximum(y, 0.0) ** 2)[:n])
-        return float(layout.comm.allreduce(local))
+        return float(self.slave.layout.comm.allreduce(local))
 
     @property
     def lumped_weights(self) -> FloatArray:

@@ -218,6 +218,7 @@ class MortarCoupling:
         self.covered_area = np.bincount(self.pairs[:, 0], weights=self.area_pairs,
                                         minlength=len(slave.cells))
         self._bases: dict[BasisKind, MortarBasis] = {}
+        self._covered_mass: Optional[tuple] = None
 
     @property
     def total_covered_area(self) -> float:
@@ -231,6 +232,19 @@ class MortarCoupling:
             self._bases[kind] = MortarBasis(kind, self.slave)
         return self._bases[kind]
 
+    def covered_element_mass(self) -> tuple[FloatArray, IntArray, FloatArray]:
+        """``∫_cov N_A N_B`` of every slave cell, the covered cells, and the nodal
+        ``W_A = ∫_cov N_A`` summed over all ranks (computed once)."""
+        if self._covered_mass is None:
+            slave = self.slave
+            nd = slave.cells.shape[1]
+            L = np.zeros((len(slave.cells), nd, nd))
+            np.add.at(L, self.pairs[:, 0], self.D_pairs)
+            covered = np.flatnonzero(self.covered_area > 0)
+            W = slave.layout.sum_at_functions(slave.cells[covered], L[covered].sum(axis=2))
+            self._covered_mass = (L, covered, W)
+        return self._covered_mass
+
     def _covered_coefficients(self, kind: BasisKind) -> FloatArray:
         """Dual coefficients rebuilt on the covered part of every covered cell
         (consistent boundary modification, Popp et al. 2013).
@@ -240,12 +254,8 @@ class MortarCoupling:
         shares a node.
         """
         C = self.basis(kind).coefficients.copy()
-        nd = self.slave.cells.shape[1]
-        L_cov = np.zeros((len(self.slave.cells), nd, nd))
-        np.add.at(L_cov, self.pairs[:, 0], self.D_pairs)
+        L_cov, covered, W_nodal = self.covered_element_mass()
         W_cov = L_cov.sum(axis=2)  # Σ_B ∫_cov N_A N_B = ∫_cov N_A
-        W_nodal = self.slave.layout.sum_at_functions(self.slave.cells, W_cov)
-        covered = np.flatnonzero(self.covered_area > 0)
         try:
             C[covered] = _kernels.basis_coefficients(kind, L_cov[covered], W_cov[covered],
                                                      W_nodal[self.slave.cells[covered]])

@@ -44,11 +44,12 @@ def _assemble_gap_derivative(model, row_cells: npt.NDArray[np.int64],
                            cols.reshape(nb, width), blocks.reshape(nb, nd, width))
 
 
-def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray
+def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: FloatArray
                            ) -> tuple[FloatArray, PETSc.Mat]:
     """``d̄⁺`` at the local slave nodes and ``G⁺`` against a rigid obstacle.
 
-    ``u_nodes``: displacement at the local slave-layout nodes, (nodes, gdim).
+    ``u_nodes``: displacement at the local slave-layout nodes, (nodes, gdim);
+    ``points``: the current quadrature points that ``model.evaluate`` returned.
     """
     slave, tab = model.slave, model.tabulation
     cells, gdim = slave.cells, slave.gdim
@@ -56,7 +57,7 @@ def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray
         u_nodes = u_nodes - model.reference
     nc, nq, nd = tab.phi.shape
     x_nodes = slave.x + u_nodes                       # current nodal positions
-    xq = np.einsum("cqb,cbk->cqk", tab.phi, x_nodes[cells] - slave.x[cells]) + tab.points
+    xq = points.reshape(nc, nq, gdim)
     d = -model.obstacle.signed_distance(xq.reshape(-1, gdim)).reshape(nc, nq)
     d_nodes = -model.obstacle.signed_distance(x_nodes[cells].reshape(-1, gdim)).reshape(nc, nd)
     samples = np.concatenate([d, d_nodes], axis=1)

@@ -344,7 +344,7 @@ class ContactProblem:
             u_nodes = nodal_displacement(self.slave, self.u)
             gaps, G, x = inner.evaluate(u_nodes)
             if pointwise:
-                gaps_plus, G_plus = obstacle_positive_gaps(inner, u_nodes)
+                gaps_plus, G_plus = obstacle_positive_gaps(inner, u_nodes, x)
         else:
             G = inner.G.copy()
             gaps = inner.evaluate(self.u.vector)
@@ -668,7 +668,8 @@ class ContactProblem:
             x.copy(self.u.vector)
             self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT,
                                       mode=PETSc.ScatterMode.FORWARD)
-            pressures = self.nodal_pressures()
+            state = self._contact()   # once per converged step: results and output
+            pressures = self.nodal_pressures(state)
             active = self.mesh.comm.allreduce(
                 int(np.sum(pressures[: self.slave.layout.num_owned] > 0)))
             s = StepResult(target, iterations, history,
@@ -678,7 +679,7 @@ class ContactProblem:
             if bar is not None:
                 bar.update(step * load_steps)
             if output is not None:
-                self._write_step(target)
+                self._write_step(target, state)
             if on_step is not None:
                 on_step(self, s)
             if self.basis_configuration == "previous":
@@ -695,22 +696,23 @@ class ContactProblem:
         """``d̄_A`` at the local slave-layout nodes for the current u."""
         return self._contact().gaps
 
-    def nodal_pressures(self) -> FloatArray:
+    def nodal_pressures(self, state: Optional[ContactState] = None) -> FloatArray:
         """Contact pressure at local nodes: ``p_A = ε⟨d̄_A⟩`` (nodal active set) or
-        ``ε d̄⁺_A`` (pointwise), consistent scaling."""
-        state = self._contact()
+        ``ε d̄⁺_A`` (pointwise), consistent scaling; ``state`` defaults to the
+        contact state at the current u."""
+        state = state or self._contact()
         if state.gaps_plus is not None:
             return self.gap_model.nodal_pressures(state.gaps_plus, positive_part=False)
         return self.gap_model.nodal_pressures(state.gaps)
 
-    def mortar_traction(self) -> FloatArray:
+    def mortar_traction(self, state: Optional[ContactState] = None) -> FloatArray:
         """The contact traction ``p* = Σ_A f_A M_A`` at the nodes of every slave cell.
 
         ``f_A = ω_A⟨d̄_A⟩`` (or ``ω_A d̄⁺_A``) and ``M`` the gap basis, so that
         the contact virtual work is ``∫ p* δd``; (cells, nodes) values, one set
         per cell because ``p*`` of the dual kinds jumps between cells.
         """
-        state = self._contact()
+        state = state or self._contact()
         cells = self.slave.cells
         if isinstance(self.gap_model, GlobalGap):   # Σ_A f_A (N L⁻¹)_A = Σ_B N_B z_B
             return state.force[cells]
@@ -734,17 +736,17 @@ class ContactProblem:
             f.write_mesh(self.mesh)
         self._surface_output = SlaveSurfaceOutput(self.slave, surface_output_path(path))
 
-    def _write_step(self, t: float) -> None:
+    def _write_step(self, t: float, state: ContactState) -> None:
         """Append the step, reopening the file so that it is complete on disk."""
-        u1, p_hat = self._output_functions()
+        pressures = self.nodal_pressures(state)
+        u1, p_hat = self._output_functions(pressures)
         with io.XDMFFile(self.mesh.comm, str(self._output), "a") as f:
             f.write_function(u1, t)
             f.write_function(p_hat, t)
-        cells = self.slave.cells
-        self._surface_output.write({"p_hat": self.nodal_pressures()[cells],
-                                    "p_star": self.mortar_traction()}, t)
+        self._surface_output.write({"p_hat": pressures[self.slave.cells],
+                                    "p_star": self.mortar_traction(state)}, t)
 
-    def _output_functions(self) -> tuple[fem.Function, fem.Function]:
+    def _output_functions(self, pressures: FloatArray) -> tuple[fem.Function, fem.Function]:
         mesh = self.mesh
         if not hasattr(self, "_out_spaces"):
             V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", mesh.geometry.cmap.degree))
@@ -754,7 +756,7 @@ class ContactProblem:
         u1 = fem.Function(V1, name="displacement")
         u1.interpolate(self.u)
         p = fem.Function(Q, name="contact_pressure")
-        p.x.array[:] = self.nodal_pressures()[q_nodes]
+        p.x.array[:] = pressures[q_nodes]
         if Q.ufl_element().degree() != mesh.geometry.cmap.degree:
             Q1 = fem.FunctionSpace(mesh, ("Lagrange", mesh.geometry.cmap.degree))
             p1 = fem.Function(Q1, name="contact_pressure")
