@@ -15,8 +15,11 @@ the dual kinds need P1 lines or triangles here. The residual is ∂Π/∂u and
 the Jacobian its exact second derivative, including the variation of the
 area element (``∂J/∂F = J F G⁻¹`` with ``G = FᵀF``) and of W.
 
-GLS/GLS* (L depends on u through every facet) and elastic masters (the
-segmentation would have to be linearized as well) are not covered.
+:class:`CurrentSurfaceGap` holds what does not depend on where the gap comes
+from (W, the nodal energy, residual and Jacobian assembly);
+:class:`CurrentObstacleGap` takes d from a rigid obstacle and
+:class:`~dolfinx_mortar.current_mortar.CurrentMortarGap` from an elastic
+master. GLS/GLS* (L depends on u through every facet) are not covered.
 """
 from __future__ import annotations
 
@@ -72,36 +75,37 @@ class CurrentState:
     G_W: PETSc.Mat           #: ∂W/∂u
     G_y: PETSc.Mat           #: ∂y/∂u
     residual: PETSc.Vec      #: ∂Π/∂u
-    a: FloatArray            #: Σ_A F_g,A φ_A at the quadrature points (cells, points)
-    b: FloatArray            #: Σ_A F_W,A N_A at the quadrature points
-    element: dict            #: per-cell arrays the second derivatives need
+    Fg: FloatArray           #: ∂F/∂ĝ_A at the local nodes
+    FW: FloatArray           #: ∂F/∂W_A at the local nodes
+    element: dict            #: area-element arrays the second derivatives of W need
+    gap_data: object         #: what the gap's source needs for Σ_A F_g,A ∂²ĝ_A
 
 
-class CurrentObstacleGap(_GapBase):
-    """Penalty contact with a rigid obstacle, bases on the current surface.
+class CurrentSurfaceGap(_GapBase):
+    """Penalty contact with the bases on the current slave surface (base class).
+
+    Subclasses give ``ĝ_A = ∫ φ_A d da`` and its derivatives
+    (:meth:`_gap`, :meth:`_gap_hessian`); this class adds W, the nodal
+    energy ``Σ_A (ε/2) W_A^m ⟨ĝ_A W_A^{−k}⟩²`` and its exact derivatives.
 
     Parameters
     ----------
     slave
         The slave surface in the reference configuration.
-    obstacle
-        The rigid obstacle.
     kind, penalty, scaling
         As for :class:`~dolfinx_mortar.contact_terms.ObstacleGap`; GLS kinds are
         not supported, dual kinds only on P1 lines and triangles.
     quadrature_degree
-        Degree of the rule on every slave facet (default 2p + 2).
+        Degree of the rule for W on every slave facet (default 2p + 2).
     """
 
-    def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: KindLike,
-                 penalty: float, scaling: str = "consistent", quadrature_degree=None):
+    def __init__(self, slave: LagrangeSurface, kind: KindLike, penalty: float,
+                 scaling: str = "consistent", quadrature_degree=None):
         if is_global(kind):
             raise NotImplementedError(
                 f"basis_configuration='current' with {kind_name(kind)}: L(u) couples every "
                 "slave facet and its linearization is not implemented; use a local kind")
         super().__init__(slave, kind, penalty, scaling)
-        if obstacle.gdim != slave.gdim:
-            raise ValueError(f"a {obstacle.gdim}D obstacle cannot touch a {slave.gdim}D body")
         ref = slave.reference
         affine = ref.degree == 1 and ref.cell in ("interval", "triangle")
         if self.kind in DUAL_KINDS and not affine:
@@ -111,7 +115,6 @@ class CurrentObstacleGap(_GapBase):
         if ref.transform is not None:
             raise NotImplementedError("basis_configuration='current' with the transformed "
                                       "quadratic basis is not implemented")
-        self.obstacle = obstacle
         X, self.wq = basix.make_quadrature(ref.cell_type, quadrature_degree or 2 * ref.degree + 2)
         self.N, self.dN = ref.tabulate(X, transformed=False)       # (q, nd), (q, tdim, nd)
         if self.kind in DUAL_KINDS:
@@ -126,22 +129,28 @@ class CurrentObstacleGap(_GapBase):
         self.m = 1 if scaling == "consistent" else 0
         self.covered = self.basis.lumped_weights > 0
 
+    # -- what a gap source provides ------------------------------------------------------
+    def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, object]:
+        """``ĝ_A`` at the local nodes (summed over ranks), ``∂ĝ/∂u`` (slave rows ×
+        dofs, Dirichlet columns not yet dropped) and data for :meth:`_gap_hessian`."""
+        raise NotImplementedError
+
+    def _gap_hessian(self, data: object, Fg: FloatArray) -> PETSc.Mat:
+        """``Σ_A F_g,A ∂²ĝ_A/∂u²`` (dofs × dofs, Dirichlet rows not yet dropped)."""
+        raise NotImplementedError
+
     # -- element quantities ------------------------------------------------------------
     def _elements(self, u_nodes: FloatArray) -> dict:
-        cells = self.slave.cells
-        x = (self.slave.x + u_nodes)[cells]                         # (c, nd, gdim)
+        """Area element J of every slave cell at the quadrature points, with its
+        first and second derivatives with respect to the cell's node positions."""
+        x = (self.slave.x + u_nodes)[self.slave.cells]              # (c, nd, gdim)
         F = np.einsum("cbi,qab->cqia", x, self.dN)                  # (c, q, gdim, tdim)
         J, dJdF, d2JdF = area_element_derivatives(F)
         # chain rule through F = Σ_b x_b ⊗ ∇N_b
         dJ = np.einsum("cqia,qab->cqbi", dJdF, self.dN)             # (c, q, nd, gdim)
         d2J = np.einsum("nqiajc,qab,qce->nqbiej", d2JdF, self.dN, self.dN)
         xq = np.einsum("qb,cbi->cqi", self.N, x)
-        nc, nq, gdim = xq.shape
-        flat = xq.reshape(-1, gdim)
-        d = -self.obstacle.signed_distance(flat).reshape(nc, nq)
-        grad = -self.obstacle.gradient(flat).reshape(nc, nq, gdim)
-        hess = -self.obstacle.hessian(flat).reshape(nc, nq, gdim, gdim)
-        return {"J": J, "dJ": dJ, "d2J": d2J, "d": d, "grad": grad, "hess": hess}
+        return {"J": J, "dJ": dJ, "d2J": d2J, "x": xq}
 
     def _nodal_coefficients(self, g: FloatArray, W: FloatArray, active: FloatArray):
         """∂F/∂ĝ, ∂F/∂W and the second derivatives of F = (ε/2) W^m ⟨ĝ W^{−k}⟩²."""
@@ -156,6 +165,13 @@ class CurrentObstacleGap(_GapBase):
         FWW = eps * (m / 2 - k) * yp ** 2 * Wsafe ** (m - 2) * ((m - 1) - 2 * k)
         return y, Fg, FW, Fgg, FgW, FWW
 
+    def _cell_columns(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """Local and global dofs of every slave cell's nodes, (cells, nd·gdim)."""
+        cells, gdim = self.slave.cells, self.slave.gdim
+        nc, nd = cells.shape
+        local = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, nd * gdim)
+        return local, self._node_dofs(cells).reshape(nc, nd * gdim)
+
     def evaluate(self, u_nodes: FloatArray, mask: PETSc.Vec) -> CurrentState:
         """Nodal gaps, their derivatives and the residual at ``u_nodes`` (local nodes).
 
@@ -165,14 +181,12 @@ class CurrentObstacleGap(_GapBase):
         cells, layout = self.slave.cells, self.slave.layout
         nc, nd = cells.shape
         gdim = self.slave.gdim
-        g, W = self._nodal_sums(e)
-        v = np.einsum("cqi,qb->cqbi", e["grad"], self.N)             # ∇d_i N_b
-        dg_c = (np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["d"], e["dJ"])
-                + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["J"], v))
+        g, G_g, gap_data = self._gap(u_nodes, e)
+        W = layout.sum_at_functions(
+            cells, np.einsum("cq,qa->ca", self.wq[None, :] * e["J"], self.N))
         dW_c = np.einsum("q,qa,cqbi->cabi", self.wq, self.N, e["dJ"])
-        cols = self._node_dofs(cells).reshape(nc, nd * gdim)
-        G_g = assemble_blocks(layout, cells, self.dofs, cols, dg_c.reshape(nc, nd, nd * gdim))
-        G_W = assemble_blocks(layout, cells, self.dofs, cols, dW_c.reshape(nc, nd, nd * gdim))
+        G_W = assemble_blocks(layout, cells, self.dofs, self._cell_columns()[1],
+                              dW_c.reshape(nc, nd, nd * gdim))
         G_g.diagonalScale(None, mask)
         G_W.diagonalScale(None, mask)
         y, Fg, FW, _, _, _ = self._nodal_coefficients(g, W, np.zeros_like(g))
@@ -188,15 +202,13 @@ class CurrentObstacleGap(_GapBase):
         if self.k:
             scaled = G_W.copy()
             scaled.diagonalScale(layout.vector(-y / Wsafe), None)
-            G_y.axpy(1.0, scaled, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        a = np.einsum("ca,qa->cq", Fg[cells], self.phi)
-        b = np.einsum("ca,qa->cq", FW[cells], self.N)
+            G_y.axpy(1.0, scaled, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         #: ω_A for the problem's fallback and gap-closing start
         self.weights = self.penalty * Wsafe ** self.m
         self._current_weights = W
         self.coefficients_std = np.broadcast_to(self.C, (nc, nd, nd)) * (
             Wsafe[cells] ** (-self.k))[:, None, :]
-        return CurrentState(g, W, y, G_g, G_W, G_y, residual, a, b, e)
+        return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, e, gap_data)
 
     def jacobian(self, state: CurrentState, active: FloatArray, mask: PETSc.Vec,
                  geometric: bool = True) -> PETSc.Mat:
@@ -218,46 +230,35 @@ class CurrentObstacleGap(_GapBase):
             out.diagonalScale(layout.vector(s), None)
             return out
 
+        Different = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
         # outer products: G_gᵀ(Fgg G_g + FgW G_W) + G_Wᵀ(FgW G_g + FWW G_W)
         left = scaled(state.G_g, Fgg)
-        left.axpy(1.0, scaled(state.G_W, FgW), structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        left.axpy(1.0, scaled(state.G_W, FgW), structure=Different)
         right = scaled(state.G_g, FgW)
-        right.axpy(1.0, scaled(state.G_W, FWW), structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        right.axpy(1.0, scaled(state.G_W, FWW), structure=Different)
         K = state.G_g.transposeMatMult(left)
-        K.axpy(1.0, state.G_W.transposeMatMult(right),
-               structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        # element second derivatives: Σ_A F_g,A ∂²ĝ_A + F_W,A ∂²W_A
-        e = state.element
+        K.axpy(1.0, state.G_W.transposeMatMult(right), structure=Different)
+        # second derivatives: Σ_A F_W,A ∂²W_A here, Σ_A F_g,A ∂²ĝ_A from the source
         cells = self.slave.cells
         nc, nd = cells.shape
-        gdim = self.slave.gdim
-        a, b, w = state.a, state.b, self.wq[None, :]
-        v = np.einsum("cqi,qb->cqbi", e["grad"], self.N)
-        blocks = (np.einsum("cq,cqbiej->cbiej", w * (a * e["d"] + b), e["d2J"])
-                  + np.einsum("cq,cqbi,cqej->cbiej", w * a, e["dJ"], v)
-                  + np.einsum("cq,cqbi,cqej->cbiej", w * a, v, e["dJ"])
-                  + np.einsum("cq,cq,cqij,qb,qe->cbiej", w * a, e["J"], e["hess"], self.N,
-                              self.N))
-        width = nd * gdim
-        local = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, width)
-        dofs = self._node_dofs(cells).reshape(nc, width)
+        width = nd * self.slave.gdim
+        b = np.einsum("ca,qa->cq", state.FW[cells], self.N)
+        blocks = np.einsum("cq,cqbiej->cbiej", self.wq[None, :] * b, state.element["d2J"])
+        local, dofs = self._cell_columns()
         K_el = assemble_blocks(self.dofs, local, self.dofs, dofs,
                                blocks.reshape(nc, width, width))
+        K_el.axpy(1.0, self._gap_hessian(state.gap_data, state.Fg), structure=Different)
         K_el.diagonalScale(mask, mask)
         K.diagonalScale(mask, mask)
-        K.axpy(1.0, K_el, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        K.axpy(1.0, K_el, structure=Different)
         return K
-
-    def _nodal_sums(self, e: dict) -> tuple[FloatArray, FloatArray]:
-        """ĝ_A = ∫ φ_A d da and W_A = ∫ N_A da on the current surface (all ranks)."""
-        cells, layout = self.slave.cells, self.slave.layout
-        wJ = self.wq[None, :] * e["J"]
-        return (layout.sum_at_functions(cells, np.einsum("cq,qa->ca", wJ * e["d"], self.phi)),
-                layout.sum_at_functions(cells, np.einsum("cq,qa->ca", wJ, self.N)))
 
     def energy(self, u_nodes: FloatArray) -> float:
         """Π_c summed over all ranks (for checking the residual)."""
-        g, W = self._nodal_sums(self._elements(u_nodes))
+        e = self._elements(u_nodes)
+        g = self._gap(u_nodes, e)[0]
+        W = self.slave.layout.sum_at_functions(
+            self.slave.cells, np.einsum("cq,qa->ca", self.wq[None, :] * e["J"], self.N))
         Wsafe = np.where(W > 0, W, 1.0)
         y = g * Wsafe ** (-self.k)
         n = self.slave.layout.num_owned
@@ -276,3 +277,52 @@ class CurrentObstacleGap(_GapBase):
         if self.k == 0:
             return force
         return np.divide(force, W, out=np.zeros_like(W), where=W > 0)
+
+
+class CurrentObstacleGap(CurrentSurfaceGap):
+    """Penalty contact with a rigid obstacle, bases on the current surface.
+
+    ``d = −φ(x + u)`` with φ the obstacle's exact signed distance, integrated
+    with the slave cell's own rule. Parameters as for
+    :class:`CurrentSurfaceGap`, plus the ``obstacle``.
+    """
+
+    def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: KindLike,
+                 penalty: float, scaling: str = "consistent", quadrature_degree=None):
+        if obstacle.gdim != slave.gdim:
+            raise ValueError(f"a {obstacle.gdim}D obstacle cannot touch a {slave.gdim}D body")
+        super().__init__(slave, kind, penalty, scaling, quadrature_degree)
+        self.obstacle = obstacle
+
+    def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
+        cells, layout = self.slave.cells, self.slave.layout
+        nc, nd = cells.shape
+        gdim = self.slave.gdim
+        flat = e["x"].reshape(-1, gdim)
+        nq = e["x"].shape[1]
+        d = -self.obstacle.signed_distance(flat).reshape(nc, nq)
+        grad = -self.obstacle.gradient(flat).reshape(nc, nq, gdim)
+        hess = -self.obstacle.hessian(flat).reshape(nc, nq, gdim, gdim)
+        wJ = self.wq[None, :] * e["J"]
+        g = layout.sum_at_functions(cells, np.einsum("cq,qa->ca", wJ * d, self.phi))
+        v = np.einsum("cqi,qb->cqbi", grad, self.N)                 # ∇d_i N_b
+        dg_c = (np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, d, e["dJ"])
+                + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["J"], v))
+        G_g = assemble_blocks(layout, cells, self.dofs, self._cell_columns()[1],
+                              dg_c.reshape(nc, nd, nd * gdim))
+        return g, G_g, {"e": e, "d": d, "v": v, "hess": hess}
+
+    def _gap_hessian(self, data: dict, Fg: FloatArray) -> PETSc.Mat:
+        e, d, v = data["e"], data["d"], data["v"]
+        cells = self.slave.cells
+        nc, nd = cells.shape
+        width = nd * self.slave.gdim
+        wa = self.wq[None, :] * np.einsum("ca,qa->cq", Fg[cells], self.phi)
+        blocks = (np.einsum("cq,cqbiej->cbiej", wa * d, e["d2J"])
+                  + np.einsum("cq,cqbi,cqej->cbiej", wa, e["dJ"], v)
+                  + np.einsum("cq,cqbi,cqej->cbiej", wa, v, e["dJ"])
+                  + np.einsum("cq,cq,cqij,qb,qe->cbiej", wa, e["J"], data["hess"], self.N,
+                              self.N))
+        local, dofs = self._cell_columns()
+        return assemble_blocks(self.dofs, local, self.dofs, dofs,
+                               blocks.reshape(nc, width, width))

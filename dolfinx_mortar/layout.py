@@ -173,6 +173,37 @@ def assemble_blocks(rows: NodeLayout, row_cells: IntArray, cols: NodeLayout,
     return mat
 
 
+
+def assemble_global_blocks(layout: NodeLayout, row_global: IntArray, col_global: IntArray,
+                           blocks: FloatArray) -> PETSc.Mat:
+    """Assemble dense blocks into a square AIJ matrix over ``layout``, with rows
+    given by global index: they may be owned by any rank (PETSc sends them).
+
+    Needed where a block's rows are not this rank's functions or ghosts, e.g.
+    the second derivatives of a slave–master pair, whose master rows can live
+    anywhere. ``blocks``: (blocks, nr, nc), added where they overlap.
+    """
+    row_global = np.asarray(row_global, dtype=PETSc.IntType)
+    nb, nr = row_global.shape
+    nc = np.asarray(col_global).shape[1] if nb else 1
+    # rows this rank fills get room for every block that touches them;
+    # other ranks' contributions beyond that allocate as they arrive
+    owned = row_global - layout.offset
+    owned = owned[(owned >= 0) & (owned < layout.num_owned)]
+    bound = np.minimum(np.bincount(owned, minlength=layout.num_owned) * nc + 1,
+                       layout.size_global).astype(PETSc.IntType)
+    mat = PETSc.Mat().createAIJ(((layout.num_owned, layout.size_global),
+                                 (layout.num_owned, layout.size_global)),
+                                nnz=(np.minimum(bound, max(layout.num_owned, 1)), bound),
+                                comm=layout.comm)
+    mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    if nb > 0:
+        mat.setValuesRCV(row_global, np.asarray(col_global, dtype=PETSc.IntType),
+                         np.ascontiguousarray(blocks, dtype=np.float64).reshape(nb, nr * nc),
+                         addv=PETSc.InsertMode.ADD_VALUES)
+    mat.assemble()
+    return mat
+
 class MassMatrixSolver:
     """A sparse direct factorization of the global slave mass matrix ``L``.
 

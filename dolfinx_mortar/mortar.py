@@ -168,6 +168,8 @@ class MortarCoupling:
         master_copy = gather_surface(master, xm)
         self.timings["normals_and_gather"] = time.perf_counter() - clock
         clock = time.perf_counter()
+        #: the gathered master surface (all ranks' cells, one node copy per cell)
+        self.master_copy = master_copy
         self.master_global_ids = master_copy.global_ids
         self.master_cells = master_copy.cells
 

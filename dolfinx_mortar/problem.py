@@ -23,7 +23,8 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_kind
 from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
-from dolfinx_mortar.finite_deformation import CurrentObstacleGap, CurrentState
+from dolfinx_mortar.current_mortar import CurrentMortarGap
+from dolfinx_mortar.finite_deformation import CurrentObstacleGap, CurrentState, CurrentSurfaceGap
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, parse_kind
 from dolfinx_mortar.mortar import MortarCoupling
 from dolfinx_mortar.layout import assemble_blocks
@@ -154,10 +155,12 @@ class ContactProblem:
     basis_configuration
         ``"initial"`` (default): bases and segmentation in the reference
         configuration; ``"previous"``: bases (and, for an elastic master, the
-        segmentation) rebuilt in the last converged configuration after every
-        load step; ``"current"``: bases on the current surface at every Newton
-        iteration with the exact linearization (rigid obstacles, local kinds;
-        :mod:`dolfinx_mortar.finite_deformation`).
+        segmentation) rebuilt in the last converged configuration when a load
+        step starts; ``"current"``: bases (and, for an elastic master, the
+        segmentation and the normals) on the current surfaces at every Newton
+        iteration with the exact linearization (local kinds; rigid obstacles
+        in 2D and 3D, :mod:`dolfinx_mortar.finite_deformation`; elastic
+        masters in 2D, :mod:`dolfinx_mortar.current_mortar`).
     fixed
         ``{tag: {component: value}}``: prescribed displacement components at
         load factor 1 (scaled by the load factor).
@@ -199,10 +202,14 @@ class ContactProblem:
         if basis_configuration not in CONFIGURATIONS:
             raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
                              f"expected {CONFIGURATIONS}")
-        if basis_configuration == "current" and obstacle is None:
+        if basis_configuration == "current" and obstacle is None and gdim != 2:
             raise NotImplementedError(
-                "basis_configuration='current' with an elastic master needs the linearization "
-                "of the segmentation, which is not implemented; it works with rigid obstacles")
+                "basis_configuration='current' with an elastic master is implemented in 2D "
+                "only (the 3D segmentation's linearization is not written); in 3D use it "
+                "with a rigid obstacle, or basis_configuration='previous'")
+        if basis_configuration == "current" and boundary_modification:
+            raise NotImplementedError("basis_configuration='current' with the boundary "
+                                      "modification is not implemented")
         if basis_configuration == "current" and active_set == "pointwise":
             raise NotImplementedError("basis_configuration='current' is implemented for the "
                                       "nodal active set only")
@@ -292,11 +299,23 @@ class ContactProblem:
         """(Re)build the gap model; for an elastic master in the configuration u."""
         clock = time.perf_counter()
         if self.basis_configuration == "current":
-            self.gap_model = CurrentObstacleGap(self.slave, self.obstacle, self.kind,
-                                                self.penalty, self.scaling)
+            self.gap_model = (
+                CurrentObstacleGap(self.slave, self.obstacle, self.kind, self.penalty,
+                                   self.scaling) if self.obstacle is not None
+                else CurrentMortarGap(self.slave, self.master, self.kind, self.penalty,
+                                      self.scaling, self.search_radius))
             self._A_total, self._bc_mask, self._last_active = None, None, None
             self.timings_segmentation = time.perf_counter() - clock
             return
+        self.gap_model = self._frozen_model(u_nodes)
+        self._A_total: Optional[PETSc.Mat] = None
+        self._bc_mask: Optional[PETSc.Vec] = None
+        self._last_active: Optional[FloatArray] = None
+        self.timings_segmentation = time.perf_counter() - clock
+
+    def _frozen_model(self, u_nodes: Optional[FloatArray]):
+        """The gap model with bases and segmentation frozen in the configuration
+        u_nodes (None: the initial one), linear in u about it."""
         if self.obstacle is not None:
             slave = self.slave if u_nodes is None else self.slave.moved(u_nodes)
             model = ObstacleGap(slave, self.obstacle, self.kind, self.penalty, self.scaling,
@@ -312,12 +331,8 @@ class ContactProblem:
             reference = self.u.vector.copy() if u_nodes is not None else None
             model = MortarGap(coupling, self.kind, self.penalty, self.scaling, reference,
                               boundary_modification=self.boundary_modification)
-        self.gap_model = (GlobalGap(model, self.kind, self.penalty, self.scaling)
-                          if is_global(self.kind) else model)
-        self._A_total: Optional[PETSc.Mat] = None
-        self._bc_mask: Optional[PETSc.Vec] = None
-        self._last_active: Optional[FloatArray] = None
-        self.timings_segmentation = time.perf_counter() - clock
+        return (GlobalGap(model, self.kind, self.penalty, self.scaling)
+                if is_global(self.kind) else model)
 
     def _mask(self) -> PETSc.Vec:
         """1 on free dofs, 0 on Dirichlet dofs (the contact terms skip those)."""
@@ -331,7 +346,7 @@ class ContactProblem:
     def _contact(self) -> "ContactState":
         """Contact state at the current u (see :class:`ContactState`)."""
         model = self.gap_model
-        if isinstance(model, CurrentObstacleGap):
+        if isinstance(model, CurrentSurfaceGap):
             current = model.evaluate(nodal_displacement(self.slave, self.u), self._mask())
             return ContactState(current.y, current.G_y,
                                 model.weights * np.maximum(current.y, 0.0), None,
@@ -536,6 +551,10 @@ class ContactProblem:
                 ones = np.ones(self.slave.layout.size_local)
                 Kc = self.gap_model.jacobian(self._state.current, ones, self._mask())
                 A.axpy(1.0, Kc, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+                if isinstance(self.gap_model, CurrentMortarGap):
+                    # the pairs, and so the pattern, change with u inside a
+                    # Newton solve: new entries are allocated as they come
+                    A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
             elif not isinstance(self.gap_model, GlobalGap):
                 Kc = G.transposeMatMult(G)
                 A.axpy(1.0, Kc, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
@@ -596,10 +615,7 @@ class ContactProblem:
         for phase in phases:
             if current is not None:
                 if phase is None:
-                    u_nodes = nodal_displacement(self.slave, self.u)
-                    self.gap_model = ObstacleGap(self.slave.moved(u_nodes), self.obstacle,
-                                                 self.kind, self.penalty, self.scaling,
-                                                 reference=u_nodes)
+                    self.gap_model = self._frozen_model(nodal_displacement(self.slave, self.u))
                 else:
                     self.gap_model = current
                     self._last_active = None
@@ -648,9 +664,18 @@ class ContactProblem:
             from tqdm import tqdm
             bar = tqdm(total=load_steps, desc="load steps", unit="step")
         x = self.u.vector.copy()
+        segmented_at: Optional[float] = None
         while reached < 1.0 - 1e-12:
             target = min(1.0, reached + step)
             self._set_load(target)
+            if self.basis_configuration == "previous" and segmented_at != reached:
+                # "previous": bases and segmentation of the last converged step,
+                # rebuilt when a step starts (not when one ends), so that the
+                # results after a step come from the model it was solved with
+                self._segment(nodal_displacement(self.slave, self.u))
+                segmented_at = reached
+                snes.destroy()
+                snes = self._snes(prefix)
             saved = self.u.vector.copy()
             clock = time.perf_counter()
             x = self.u.vector.copy()
@@ -682,10 +707,6 @@ class ContactProblem:
                 self._write_step(target, state)
             if on_step is not None:
                 on_step(self, s)
-            if self.basis_configuration == "previous":
-                self._segment(nodal_displacement(self.slave, self.u))
-                snes.destroy()
-                snes = self._snes(prefix)
         if bar is not None:
             bar.close()
         snes.destroy()

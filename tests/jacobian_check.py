@@ -41,3 +41,26 @@ def residual_difference(problem, x0, direction, size: float = 1e-6):
     fd.axpy(-1.0, residuals[1])
     fd.scale(1 / (2 * h))
     return fd
+
+
+def newton_history(start, problem, prefix: str) -> np.ndarray:
+    """Residual norms of ``problem``'s Newton solve at full load, started from
+    the solution of ``start`` (a problem on the same function space)."""
+    problem._set_load(1.0)
+    start.u.vector.copy(problem.u.vector)
+    problem.u.x.scatter_forward()
+    snes = problem._snes(prefix)
+    x = problem.u.vector.copy()
+    snes.setConvergenceHistory(reset=True)
+    snes.solve(None, x)
+    r = np.array(snes.getConvergenceHistory()[0])
+    snes.destroy()
+    return r
+
+
+def convergence_order(r: np.ndarray) -> float:
+    """log e_k / log e_(k−1), e = r/r_0, at the last iterate that made progress
+    above round-off (2 for quadratic convergence)."""
+    e = r / r[0]
+    k = np.flatnonzero((e[1:] < 0.5 * e[:-1]) & (e[1:] > 1e-11))[-1] + 1
+    return float(np.log(e[k]) / np.log(e[k - 1])) if k >= 2 else 0.0

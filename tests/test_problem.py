@@ -93,23 +93,30 @@ def test_hertz2d_pressure_error_falls_with_refinement():
     assert errors[1] < 0.7 * errors[0], errors
 
 
-@pytest.mark.parametrize("kind, active_set", [("LcLS*", "nodal"), ("LmLS*", "pointwise")])
-def test_hertz2d_same_figures_on_one_and_all_ranks(kind, active_set):
+def assert_same_hertz2d_figures_on_one_and_all_ranks(argv: list, make_problem) -> None:
+    """Solve the Hertz 2D scene of ``argv`` on all ranks and on this rank alone
+    (``make_problem(demo, V, tags, h)`` builds the problem, two load steps)."""
     demo = load("hertz2d")
-    args = demo.parse_args(["--refine", "0.4", "--load-steps", "2"])
+    args = demo.parse_args(argv)
     results = []
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
         ref = demo.hertz(args)
         domain, tags, h = demo.build_mesh(args, ref["a"], comm)
-        V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
-        problem = ContactProblem(V, tags, demo.SLAVE, obstacle=RigidPlane([0, 0], [0, 1]),
-                                 E=1.0, nu=0.3, kind=kind, penalty=1e3 / h,
-                                 active_set=active_set, fixed={demo.SYMMETRY: {0: 0.0}},
-                                 tractions={demo.LOAD: [0.0, -0.005]})
+        problem = make_problem(demo, fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags, h)
         problem.solve(load_steps=2)
         results.append(demo.contact_results(problem, ref))
     for key in ("p0", "a", "l2_error", "contact_force"):
         assert results[0][key] == pytest.approx(results[1][key], rel=1e-8), key
+
+
+@pytest.mark.parametrize("kind, active_set", [("LcLS*", "nodal"), ("LmLS*", "pointwise")])
+def test_hertz2d_same_figures_on_one_and_all_ranks(kind, active_set):
+    def make_problem(demo, V, tags, h):
+        return ContactProblem(V, tags, demo.SLAVE, obstacle=RigidPlane([0, 0], [0, 1]),
+                              E=1.0, nu=0.3, kind=kind, penalty=1e3 / h,
+                              active_set=active_set, fixed={demo.SYMMETRY: {0: 0.0}},
+                              tractions={demo.LOAD: [0.0, -0.005]})
+    assert_same_hertz2d_figures_on_one_and_all_ranks(["--refine", "0.4"], make_problem)
 
 
 @pytest.mark.parametrize("kind", ["LmLS", "LcLS*"])
