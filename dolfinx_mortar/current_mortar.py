@@ -13,9 +13,8 @@ it depends on: the slave cell's, its neighbours' (through the averaged
 normals) and the master cell's. The kernel still picks the pairs; its values
 must equal these (tested), which ties the two implementations together.
 
-Only lines (2D). In 3D the same construction runs through polygon clipping,
-whose vertices switch between slave nodes, master nodes and edge crossings;
-that is not written.
+Lines here; P1 triangles in :mod:`dolfinx_mortar.current_mortar_3d`, where the
+same construction runs through polygon clipping.
 """
 from __future__ import annotations
 
@@ -25,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
+from dolfinx_mortar.current_mortar_3d import TrianglePatches, pair_jets_3d
 from dolfinx_mortar.finite_deformation import CurrentSurfaceGap
 from dolfinx_mortar.jet import Jet, dot, maximum, minimum
 from dolfinx_mortar.kinds import KindLike
@@ -110,7 +110,7 @@ def project_along_line(degree: int, nodes: list, x: list, e1: list, start: float
 
 class CurrentMortarGap(CurrentSurfaceGap):
     """Penalty contact with an elastic master in one mesh, everything on the
-    current configuration, exact Jacobian (2D).
+    current configuration, exact Jacobian (2D: lines; 3D: P1 triangles).
 
     Parameters
     ----------
@@ -126,11 +126,11 @@ class CurrentMortarGap(CurrentSurfaceGap):
     def __init__(self, slave: LagrangeSurface, master: LagrangeSurface, kind: KindLike,
                  penalty: float, scaling: str = "consistent",
                  search_radius: Optional[float] = None):
-        if slave.gdim != 2:
+        if slave.gdim == 3 and not (slave.reference.name == master.reference.name == "P1 triangle"):
             raise NotImplementedError(
-                "basis_configuration='current' with an elastic master is implemented in 2D "
-                "only: in 3D the linearization would have to follow the clipped polygons' "
-                "vertices as they switch between nodes and edge crossings")
+                "basis_configuration='current' with an elastic master in 3D is implemented "
+                "for P1 triangle facets only (got "
+                f"{slave.reference.name} and {master.reference.name})")
         if master.layout.size_global != slave.layout.size_global:
             raise ValueError("slave and master must share one displacement space (one mesh)")
         super().__init__(slave, kind, penalty, scaling)
@@ -139,8 +139,11 @@ class CurrentMortarGap(CurrentSurfaceGap):
         self.master_degree = master.reference.degree
         degree = _polynomial_degree(slave) + max(_polynomial_degree(slave),
                                                  _polynomial_degree(master))
-        self.segment_points, self.segment_weights = _segment_quadrature(1, degree)
-        self._neighbours = self._normal_neighbours()
+        self.segment_points, self.segment_weights = _segment_quadrature(slave.tdim, degree)
+        if slave.gdim == 2:
+            self._neighbours = self._normal_neighbours()
+        else:
+            self._patches = TrianglePatches(slave)
         self.covered = np.zeros(slave.layout.size_local, dtype=bool)
         #: the kernel's coupling at the last evaluation (pairs, reference values)
         self.coupling: Optional[MortarCoupling] = None
@@ -277,16 +280,20 @@ class CurrentMortarGap(CurrentSurfaceGap):
         pairs = coupling.pairs
         cells = slave.cells[pairs[:, 0]]
         ns = cells.shape[1]
-        values, dofs = self._pair_variables(u_nodes, coupling)
-        nv = values.shape[1]
-        if len(pairs):
-            c = self.pair_gaps(values, pairs)
-            value = np.column_stack([ca.value for ca in c])
-            grad = np.stack([ca.grad for ca in c], axis=1)                 # (p, ns, nv)
-            hess = np.stack([ca.hess for ca in c], axis=1)                 # (p, ns, nv, nv)
+        if slave.gdim == 3:
+            value, grad, hess, dofs = pair_jets_3d(self._patches, slave, u_nodes, coupling,
+                                                   self.segment_points, self.segment_weights)
         else:
-            value, grad = np.zeros((0, ns)), np.zeros((0, ns, nv))
-            hess = np.zeros((0, ns, nv, nv))
+            values, dofs = self._pair_variables(u_nodes, coupling)
+            nv = values.shape[1]
+            if len(pairs):
+                c = self.pair_gaps(values, pairs)
+                value = np.column_stack([ca.value for ca in c])
+                grad = np.stack([ca.grad for ca in c], axis=1)             # (p, ns, nv)
+                hess = np.stack([ca.hess for ca in c], axis=1)             # (p, ns, nv, nv)
+            else:
+                value, grad = np.zeros((0, ns)), np.zeros((0, ns, nv))
+                hess = np.zeros((0, ns, nv, nv))
         # φ_a = Σ_b N_b C_ba
         value = value @ self.C
         grad = np.einsum("pbn,ba->pan", grad, self.C)

@@ -81,7 +81,8 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     f2c = mesh.topology.connectivity(fdim, tdim)
     c2f = mesh.topology.connectivity(tdim, fdim)
     cell_of_facet = f2c.array[f2c.offsets[facets]]
-    num_facets_per_cell = c2f.offsets[1] - c2f.offsets[0]
+    # from the cell type: a rank may own no cell at all
+    num_facets_per_cell = dolfinx.cpp.mesh.cell_num_entities(mesh.topology.cell_type, fdim)
     cell_facets = c2f.array.reshape(-1, num_facets_per_cell)[cell_of_facet]
     local_facet = np.argmax(cell_facets == facets[:, None], axis=1)
 

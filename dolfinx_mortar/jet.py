@@ -115,6 +115,16 @@ class Jet:
         """The value alone (to take a derivative-free branch decision)."""
         return self.value
 
+    def take(self, indices: npt.ArrayLike) -> "Jet":
+        """The batch entries ``indices`` (repeats allowed)."""
+        i = np.asarray(indices)
+        return Jet(self.value[i], self.grad[i], None if self.hess is None else self.hess[i])
+
+    def sum(self) -> "Jet":
+        """The sum over the batch, as a batch of one."""
+        return Jet(self.value.sum(keepdims=True), self.grad.sum(axis=0, keepdims=True),
+                   None if self.hess is None else self.hess.sum(axis=0, keepdims=True))
+
 
 def where(condition: npt.NDArray[np.bool_], a: Union[Jet, Scalar], b: Union[Jet, Scalar],
           like: Jet) -> Jet:
@@ -132,6 +142,18 @@ def where(condition: npt.NDArray[np.bool_], a: Union[Jet, Scalar], b: Union[Jet,
         hess = np.where(c[:, None, None], zero if a.hess is None else a.hess,
                         zero if b.hess is None else b.hess)
     return Jet(np.where(c, a.value, b.value), np.where(c[:, None], a.grad, b.grad), hess)
+
+
+def stack(jets: list) -> Jet:
+    """One Jet whose batch is the concatenation of the given Jets' batches (a
+    batch of one broadcasts as usual in the arithmetic that follows)."""
+    grads = [np.broadcast_to(j.grad, (len(j.value), j.grad.shape[-1])) for j in jets]
+    hess = None
+    if any(j.hess is not None for j in jets):
+        n = grads[0].shape[-1]
+        hess = np.concatenate([np.zeros((len(j.value), n, n)) if j.hess is None else j.hess
+                               for j in jets])
+    return Jet(np.concatenate([j.value for j in jets]), np.concatenate(grads), hess)
 
 
 def maximum(a: Jet, b: Jet) -> Jet:

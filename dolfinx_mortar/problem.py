@@ -160,7 +160,7 @@ class ContactProblem:
         segmentation and the normals) on the current surfaces at every Newton
         iteration with the exact linearization (local kinds; rigid obstacles
         in 2D and 3D, :mod:`dolfinx_mortar.finite_deformation`; elastic
-        masters in 2D, :mod:`dolfinx_mortar.current_mortar`).
+        masters on lines and P1 triangles, :mod:`dolfinx_mortar.current_mortar`).
     fixed
         ``{tag: {component: value}}``: prescribed displacement components at
         load factor 1 (scaled by the load factor).
@@ -202,11 +202,6 @@ class ContactProblem:
         if basis_configuration not in CONFIGURATIONS:
             raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
                              f"expected {CONFIGURATIONS}")
-        if basis_configuration == "current" and obstacle is None and gdim != 2:
-            raise NotImplementedError(
-                "basis_configuration='current' with an elastic master is implemented in 2D "
-                "only (the 3D segmentation's linearization is not written); in 3D use it "
-                "with a rigid obstacle, or basis_configuration='previous'")
         if basis_configuration == "current" and boundary_modification:
             raise NotImplementedError("basis_configuration='current' with the boundary "
                                       "modification is not implemented")
