@@ -159,7 +159,7 @@ def test_previous_configuration_converges_to_current_as_the_steps_shrink():
         p0 = demo.contact_results(previous, demo.hertz(demo.parse_args([])))["p0"]
         differences.append(abs(p0 - p_current) / p_current)
     assert differences[1] < 0.35 * differences[0], differences   # ≈ ¼ per 4× steps
-    assert differences[1] < 1e-3
+    assert differences[1] < 2e-3   # 8.4e-4 measured (16 steps)
 
 
 def test_current_configuration_reports_what_it_cannot_do():
