@@ -128,6 +128,11 @@ class CurrentSurfaceGap(_GapBase):
         self.k = 0 if (scaling == "seed" and is_partition_of_unity(self.kind)) else 1
         self.m = 1 if scaling == "consistent" else 0
         self.covered = self.basis.lumped_weights > 0
+        cells, gdim = slave.cells, slave.gdim
+        nc, nd = cells.shape
+        #: local and global dofs of every slave cell's nodes, (cells, nd·gdim)
+        self.cell_dofs_local = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, nd * gdim)
+        self.cell_dofs = self._node_dofs(cells).reshape(nc, nd * gdim)
 
     # -- what a gap source provides ------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, object]:
@@ -165,12 +170,10 @@ class CurrentSurfaceGap(_GapBase):
         FWW = eps * (m / 2 - k) * yp ** 2 * Wsafe ** (m - 2) * ((m - 1) - 2 * k)
         return y, Fg, FW, Fgg, FgW, FWW
 
-    def _cell_columns(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
-        """Local and global dofs of every slave cell's nodes, (cells, nd·gdim)."""
-        cells, gdim = self.slave.cells, self.slave.gdim
-        nc, nd = cells.shape
-        local = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, nd * gdim)
-        return local, self._node_dofs(cells).reshape(nc, nd * gdim)
+    def _lumped_weights(self, e: dict) -> FloatArray:
+        """``W_A = ∫ N_A da`` on the surface of the element quantities ``e``."""
+        return self.slave.layout.sum_at_functions(
+            self.slave.cells, np.einsum("cq,qa->ca", self.wq[None, :] * e["J"], self.N))
 
     def evaluate(self, u_nodes: FloatArray, mask: PETSc.Vec) -> CurrentState:
         """Nodal gaps, their derivatives and the residual at ``u_nodes`` (local nodes).
@@ -182,10 +185,9 @@ class CurrentSurfaceGap(_GapBase):
         nc, nd = cells.shape
         gdim = self.slave.gdim
         g, G_g, gap_data = self._gap(u_nodes, e)
-        W = layout.sum_at_functions(
-            cells, np.einsum("cq,qa->ca", self.wq[None, :] * e["J"], self.N))
+        W = self._lumped_weights(e)
         dW_c = np.einsum("q,qa,cqbi->cabi", self.wq, self.N, e["dJ"])
-        G_W = assemble_blocks(layout, cells, self.dofs, self._cell_columns()[1],
+        G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
                               dW_c.reshape(nc, nd, nd * gdim))
         G_g.diagonalScale(None, mask)
         G_W.diagonalScale(None, mask)
@@ -244,8 +246,7 @@ class CurrentSurfaceGap(_GapBase):
         width = nd * self.slave.gdim
         b = np.einsum("ca,qa->cq", state.FW[cells], self.N)
         blocks = np.einsum("cq,cqbiej->cbiej", self.wq[None, :] * b, state.element["d2J"])
-        local, dofs = self._cell_columns()
-        K_el = assemble_blocks(self.dofs, local, self.dofs, dofs,
+        K_el = assemble_blocks(self.dofs, self.cell_dofs_local, self.dofs, self.cell_dofs,
                                blocks.reshape(nc, width, width))
         K_el.axpy(1.0, self._gap_hessian(state.gap_data, state.Fg), structure=Different)
         K_el.diagonalScale(mask, mask)
@@ -257,8 +258,7 @@ class CurrentSurfaceGap(_GapBase):
         """Π_c summed over all ranks (for checking the residual)."""
         e = self._elements(u_nodes)
         g = self._gap(u_nodes, e)[0]
-        W = self.slave.layout.sum_at_functions(
-            self.slave.cells, np.einsum("cq,qa->ca", self.wq[None, :] * e["J"], self.N))
+        W = self._lumped_weights(e)
         Wsafe = np.where(W > 0, W, 1.0)
         y = g * Wsafe ** (-self.k)
         n = self.slave.layout.num_owned
@@ -308,7 +308,7 @@ class CurrentObstacleGap(CurrentSurfaceGap):
         v = np.einsum("cqi,qb->cqbi", grad, self.N)                 # ∇d_i N_b
         dg_c = (np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, d, e["dJ"])
                 + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["J"], v))
-        G_g = assemble_blocks(layout, cells, self.dofs, self._cell_columns()[1],
+        G_g = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
                               dg_c.reshape(nc, nd, nd * gdim))
         return g, G_g, {"e": e, "d": d, "v": v, "hess": hess}
 
@@ -323,6 +323,5 @@ class CurrentObstacleGap(CurrentSurfaceGap):
                   + np.einsum("cq,cqbi,cqej->cbiej", wa, v, e["dJ"])
                   + np.einsum("cq,cq,cqij,qb,qe->cbiej", wa, e["J"], data["hess"], self.N,
                               self.N))
-        local, dofs = self._cell_columns()
-        return assemble_blocks(self.dofs, local, self.dofs, dofs,
+        return assemble_blocks(self.dofs, self.cell_dofs_local, self.dofs, self.cell_dofs,
                                blocks.reshape(nc, width, width))

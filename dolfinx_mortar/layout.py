@@ -125,6 +125,26 @@ class NodeLayout:
                                element_matrices, unit_diagonal=True)
 
 
+def _block_matrix(rows: NodeLayout, cols: NodeLayout, bound: npt.NDArray,
+                  row_global: IntArray, col_global: IntArray, blocks: FloatArray) -> PETSc.Mat:
+    """A rows × cols AIJ matrix preallocated with ``bound`` nonzeros per owned
+    row (more allocate as they come), with the blocks added (not assembled)."""
+    bound = np.minimum(bound, cols.size_global).astype(PETSc.IntType)
+    mat = PETSc.Mat().createAIJ(((rows.num_owned, rows.size_global),
+                                 (cols.num_owned, cols.size_global)),
+                                nnz=(np.minimum(bound, max(cols.num_owned, 1)), bound),
+                                comm=rows.comm)
+    mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    nb, nr = row_global.shape
+    if nb > 0:  # petsc4py divides by the batch size
+        nc = np.asarray(col_global).shape[1]
+        mat.setValuesRCV(row_global.astype(PETSc.IntType),
+                         np.asarray(col_global, dtype=PETSc.IntType),
+                         np.ascontiguousarray(blocks, dtype=np.float64).reshape(nb, nr * nc),
+                         addv=PETSc.InsertMode.ADD_VALUES)
+    return mat
+
+
 def assemble_blocks(rows: NodeLayout, row_cells: IntArray, cols: NodeLayout,
                     col_global: IntArray, blocks: FloatArray,
                     unit_diagonal: bool = False) -> PETSc.Mat:
@@ -145,23 +165,13 @@ def assemble_blocks(rows: NodeLayout, row_cells: IntArray, cols: NodeLayout,
         matrices only).
     """
     row_cells = np.asarray(row_cells, dtype=np.int64)
-    nb, nr = row_cells.shape
+    nb = row_cells.shape[0]
     nc = np.asarray(col_global).shape[1] if nb else 1
     touches = rows.sum_at_functions(row_cells, np.ones(row_cells.shape))
     # Each touching block adds at most nc columns; off-rank contributions make
     # an exact count costly, so preallocate this bound.
-    bound = np.minimum(touches[: rows.num_owned] * nc + 1, cols.size_global)
-    bound = bound.astype(PETSc.IntType)
-    mat = PETSc.Mat().createAIJ(((rows.num_owned, rows.size_global),
-                                 (cols.num_owned, cols.size_global)),
-                                nnz=(np.minimum(bound, max(cols.num_owned, 1)), bound),
-                                comm=rows.comm)
-    mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-    row_global = rows.global_indices[row_cells].astype(PETSc.IntType)
-    if nb > 0:  # petsc4py divides by the batch size
-        mat.setValuesRCV(row_global, np.asarray(col_global, dtype=PETSc.IntType),
-                         np.ascontiguousarray(blocks, dtype=np.float64).reshape(nb, nr * nc),
-                         addv=PETSc.InsertMode.ADD_VALUES)
+    mat = _block_matrix(rows, cols, touches[: rows.num_owned] * nc + 1,
+                        rows.global_indices[row_cells], col_global, blocks)
     if unit_diagonal:
         untouched = (rows.offset + np.flatnonzero(touches[: rows.num_owned] == 0)
                      ).astype(PETSc.IntType)
@@ -173,7 +183,6 @@ def assemble_blocks(rows: NodeLayout, row_cells: IntArray, cols: NodeLayout,
     return mat
 
 
-
 def assemble_global_blocks(layout: NodeLayout, row_global: IntArray, col_global: IntArray,
                            blocks: FloatArray) -> PETSc.Mat:
     """Assemble dense blocks into a square AIJ matrix over ``layout``, with rows
@@ -183,26 +192,17 @@ def assemble_global_blocks(layout: NodeLayout, row_global: IntArray, col_global:
     the second derivatives of a slave–master pair, whose master rows can live
     anywhere. ``blocks``: (blocks, nr, nc), added where they overlap.
     """
-    row_global = np.asarray(row_global, dtype=PETSc.IntType)
-    nb, nr = row_global.shape
-    nc = np.asarray(col_global).shape[1] if nb else 1
+    row_global = np.asarray(row_global, dtype=np.int64)
+    nc = np.asarray(col_global).shape[1] if row_global.shape[0] else 1
     # rows this rank fills get room for every block that touches them;
     # other ranks' contributions beyond that allocate as they arrive
     owned = row_global - layout.offset
     owned = owned[(owned >= 0) & (owned < layout.num_owned)]
-    bound = np.minimum(np.bincount(owned, minlength=layout.num_owned) * nc + 1,
-                       layout.size_global).astype(PETSc.IntType)
-    mat = PETSc.Mat().createAIJ(((layout.num_owned, layout.size_global),
-                                 (layout.num_owned, layout.size_global)),
-                                nnz=(np.minimum(bound, max(layout.num_owned, 1)), bound),
-                                comm=layout.comm)
-    mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-    if nb > 0:
-        mat.setValuesRCV(row_global, np.asarray(col_global, dtype=PETSc.IntType),
-                         np.ascontiguousarray(blocks, dtype=np.float64).reshape(nb, nr * nc),
-                         addv=PETSc.InsertMode.ADD_VALUES)
+    mat = _block_matrix(layout, layout, np.bincount(owned, minlength=layout.num_owned) * nc + 1,
+                        row_global, col_global, blocks)
     mat.assemble()
     return mat
+
 
 class MassMatrixSolver:
     """A sparse direct factorization of the global slave mass matrix ``L``.

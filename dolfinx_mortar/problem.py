@@ -303,6 +303,8 @@ class ContactProblem:
             self.timings_segmentation = time.perf_counter() - clock
             return
         self.gap_model = self._frozen_model(u_nodes)
+        #: the nodal displacement the frozen model was built at (None: zero)
+        self._segmented_at = None if u_nodes is None else u_nodes.copy()
         self._A_total: Optional[PETSc.Mat] = None
         self._bc_mask: Optional[PETSc.Vec] = None
         self._last_active: Optional[FloatArray] = None
@@ -328,6 +330,13 @@ class ContactProblem:
                               boundary_modification=self.boundary_modification)
         return (GlobalGap(model, self.kind, self.penalty, self.scaling)
                 if is_global(self.kind) else model)
+
+    def _moved_since_segmentation(self) -> bool:
+        """Whether u differs from the displacement the frozen model was built at."""
+        u_nodes = nodal_displacement(self.slave, self.u)
+        moved = (np.any(u_nodes != 0) if self._segmented_at is None
+                 else not np.array_equal(u_nodes, self._segmented_at))
+        return self.mesh.comm.allreduce(bool(moved), op=MPI.LOR)
 
     def _mask(self) -> PETSc.Vec:
         """1 on free dofs, 0 on Dirichlet dofs (the contact terms skip those)."""
@@ -659,16 +668,14 @@ class ContactProblem:
             from tqdm import tqdm
             bar = tqdm(total=load_steps, desc="load steps", unit="step")
         x = self.u.vector.copy()
-        segmented_at: Optional[float] = None
         while reached < 1.0 - 1e-12:
             target = min(1.0, reached + step)
             self._set_load(target)
-            if self.basis_configuration == "previous" and segmented_at != reached:
+            if self.basis_configuration == "previous" and self._moved_since_segmentation():
                 # "previous": bases and segmentation of the last converged step,
                 # rebuilt when a step starts (not when one ends), so that the
                 # results after a step come from the model it was solved with
                 self._segment(nodal_displacement(self.slave, self.u))
-                segmented_at = reached
                 snes.destroy()
                 snes = self._snes(prefix)
             saved = self.u.vector.copy()

@@ -11,7 +11,7 @@ from dolfinx_mortar.finite_deformation import area_element_derivatives
 from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar.problem import ContactProblem
 from jacobian_check import convergence_order, jacobian_error, newton_history
-from test_problem import LOCAL_KINDS, block_on_plane, load
+from test_problem import LOCAL_KINDS, block_on_plane, load, pressed_block
 
 
 @pytest.mark.parametrize("shape", [(2, 1), (3, 1), (3, 2)])
@@ -32,12 +32,8 @@ def test_area_element_derivatives_match_differences(shape):
 def _deformed_block(kind, scaling, n=(8, 3)):
     """A block pressed into a rigid disk and sheared: several nodes active, and a
     displacement (5% of the block) large enough for the bases to change."""
-    V, tags = block_on_plane(n=n)
-    problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -2.0], 2.01), E=1.0,
-                             nu=0.3, kind=kind, penalty=50.0, scaling=scaling,
-                             fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]},
-                             basis_configuration="current")
-    problem._set_load(1.0)
+    problem = pressed_block(RigidSphere([0.5, -2.0], 2.01), kind, n=n, scaling=scaling,
+                            basis_configuration="current")
     problem.u.interpolate(lambda x: np.vstack([0.05 * x[1] + 0.1 * x[0] ** 2,
                                                -0.02 + 0.003 * x[0] ** 2 + 0.004 * x[0]]))
     return problem

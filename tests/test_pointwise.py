@@ -10,7 +10,7 @@ from dolfinx_mortar.cut_quadrature import positive_part_rule
 from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
 from jacobian_check import jacobian_error
-from test_problem import ALL_KINDS, block_on_plane, load
+from test_problem import ALL_KINDS, block_on_plane, load, pressed_block
 
 # dual kinds appear here on purpose; the warning itself is tested at the end
 pytestmark = pytest.mark.filterwarnings("ignore:the pointwise active set with a dual kind")
@@ -45,14 +45,10 @@ def test_cut_rule_converges_for_a_curved_zero_line():
 @pytest.mark.parametrize("kind", ["LmLS*", "LmLS", "LcLS*"])
 @pytest.mark.parametrize("obstacle", ["plane", "sphere"])
 def test_pointwise_jacobian_matches_finite_differences_on_cut_cells(kind, obstacle):
-    V, tags = block_on_plane(n=(6, 3))
     # the obstacle cuts the slave in the middle of cells, so the split rule is exercised
     ob = (RigidPlane([0, 0.0], [0.2, 1]) if obstacle == "plane"
           else RigidSphere([0.5, -2.0], 2.0))
-    problem = ContactProblem(V, tags, 1, obstacle=ob, E=1.0, nu=0.3, kind=kind, penalty=50.0,
-                             fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]},
-                             active_set="pointwise")
-    problem._set_load(1.0)
+    problem = pressed_block(ob, kind, active_set="pointwise")
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[1], -0.0031 + 0.003 * x[0] ** 2]))
     state = problem._contact()
     n = problem.slave.layout.num_owned

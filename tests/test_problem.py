@@ -119,15 +119,23 @@ def test_hertz2d_same_figures_on_one_and_all_ranks(kind, active_set):
     assert_same_hertz2d_figures_on_one_and_all_ranks(["--refine", "0.4"], make_problem)
 
 
+def pressed_block(obstacle, kind: str, n=(6, 3), **options) -> ContactProblem:
+    """The block of :func:`block_on_plane` against ``obstacle``, fixed sideways on
+    its left, pushed down on its top (penalty 50), at full load."""
+    V, tags = block_on_plane(n=n)
+    problem = ContactProblem(V, tags, 1, obstacle=obstacle, E=1.0, nu=0.3, kind=kind,
+                             penalty=50.0, fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]},
+                             **options)
+    problem._set_load(1.0)
+    return problem
+
+
 @pytest.mark.parametrize("kind", ["LmLS", "LcLS*"])
 @pytest.mark.parametrize("obstacle", ["plane", "sphere"])
 def test_jacobian_matches_finite_differences(kind, obstacle):
-    V, tags = block_on_plane(n=(6, 3))
     ob = (RigidPlane([0, 0.01], [0, 1]) if obstacle == "plane"
           else RigidSphere([0.5, -2.0], 2.01))
-    problem = ContactProblem(V, tags, 1, obstacle=ob, E=1.0, nu=0.3, kind=kind, penalty=50.0,
-                             fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]})
-    problem._set_load(1.0)
+    problem = pressed_block(ob, kind)
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[1], -0.002 + 0.003 * x[0] ** 2]))
     x0 = problem.u.vector.copy()
     J = problem._total_matrix()
