@@ -82,6 +82,8 @@ def test_missing_the_normal_linearization_is_detected():
     problem = _sheared_blocks("LmLS*")
     model = problem.gap_model
     exact = model.pair_gaps
+    # the same direction both times (fixed seeds): only the normals' terms differ
+    exact_error = _energy_gradient_error(problem)
 
     def frozen_normals(values, pairs):
         """Neighbour nodes held at their values: the normals lose their derivatives."""
@@ -93,7 +95,10 @@ def test_missing_the_normal_linearization_is_detected():
         return c
 
     model.pair_gaps = frozen_normals
-    assert _energy_gradient_error(problem) > 1e-7    # measured 3.3e-7; exact: 3e-10
+    # measured 3.3e-7 against 3e-10 serial; 9.8e-8 on one 2-rank partition, so
+    # the bound is relative to the exact error, not absolute
+    frozen_error = _energy_gradient_error(problem)
+    assert frozen_error > 30 * exact_error, (exact_error, frozen_error)
 
 
 @pytest.mark.parametrize("kind", LOCAL_KINDS)
