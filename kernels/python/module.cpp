@@ -7,6 +7,7 @@
 #include <dolfinx_mortar/bounding_box_tree.h>
 #include <dolfinx_mortar/element_integrals.h>
 #include <dolfinx_mortar/facet_element.h>
+#include <dolfinx_mortar/geometric_tolerance.h>
 #include <dolfinx_mortar/mortar_integrals.h>
 #include <dolfinx_mortar/surface_geometry.h>
 
@@ -84,6 +85,19 @@ to_numpy(const std::vector<double>& v, std::vector<py::ssize_t> shape)
 PYBIND11_MODULE(_kernels, m)
 {
   m.doc() = "dolfinx_mortar C++ kernels";
+
+  m.attr("geometric_tolerance") = geometric_tolerance;
+  m.def(
+    "length_scale",
+    [](const array_t& x)
+    {
+      if (x.ndim() != 2)
+        throw std::invalid_argument("x must have shape (points, gdim)");
+      return length_scale(as_span(x), static_cast<int>(x.shape(1)));
+    },
+    py::arg("x"),
+    "Largest coordinate magnitude or bounding-box diagonal of x (points, "
+    "gdim)");
 
   py::enum_<BasisKind>(m, "BasisKind")
     .value("GLS", BasisKind::GLS)

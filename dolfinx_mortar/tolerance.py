@@ -1,0 +1,50 @@
+"""The geometric tolerance, in one place for the kernels and the Python layer.
+
+Every decision "is this length, area or distance zero?" is taken against
+``GEOMETRIC_TOLERANCE × length scale``, where the length scale is the larger
+of the coordinates' magnitude and the geometry's extent (DESIGN.md §6): the
+round-off in a computed length grows with the first, and differs from one CPU
+to the next, so a computed float is never compared with exact zero or with a
+tolerance relative to itself. The constant is the C++ kernels' own
+(``kernels/include/dolfinx_mortar/geometric_tolerance.h``).
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+from dolfinx_mortar import _kernels
+
+#: relative tolerance of every geometric decision (the kernels' constant)
+GEOMETRIC_TOLERANCE: float = _kernels.geometric_tolerance
+
+
+def length_scale(x: npt.ArrayLike, comm: Optional[MPI.Comm] = None) -> float:
+    """Largest coordinate magnitude or bounding-box diagonal of points ``x``.
+
+    With ``comm`` the scale is taken over every rank's points, so that a
+    decision does not depend on how the mesh is partitioned.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    if x.ndim != 2:
+        raise ValueError(f"points must have shape (points, gdim), got {x.shape}")
+    if comm is None or comm.size == 1:
+        return float(_kernels.length_scale(np.ascontiguousarray(x))) if len(x) else 0.0
+    # the bounding box and magnitude over all ranks (a rank may hold no point)
+    gdim = x.shape[1]
+    lo = x.min(axis=0) if len(x) else np.full(gdim, np.inf)
+    hi = x.max(axis=0) if len(x) else np.full(gdim, -np.inf)
+    lo = np.min(comm.allgather(lo), axis=0)
+    hi = np.max(comm.allgather(hi), axis=0)
+    magnitude = comm.allreduce(float(np.abs(x).max()) if len(x) else 0.0, op=MPI.MAX)
+    if not np.all(np.isfinite(lo)):
+        return magnitude
+    return max(magnitude, float(np.linalg.norm(hi - lo)))
+
+
+def zero_length(scale: float) -> float:
+    """The length below which a length is zero for a geometry of ``scale``."""
+    return max(GEOMETRIC_TOLERANCE * scale, np.finfo(np.float64).tiny)

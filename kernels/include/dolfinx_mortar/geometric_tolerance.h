@@ -1,0 +1,30 @@
+// Copyright (C) 2026 dolfinx_mortar developers
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include <span>
+
+namespace dolfinx_mortar
+{
+
+/// The one relative tolerance of every geometric decision (degenerate facet,
+/// point on an edge, zero-area overlap). A length is zero when it is below
+/// geometric_tolerance times the geometry's length scale (length_scale()).
+/// Round-off in a computed length is a few 1e-16 of the coordinates'
+/// magnitude and differs between CPUs; facets a millionth of their
+/// neighbours' size are real input. 1e-10 sits between the two with margin
+/// on both sides, so no decision depends on where round-off lands.
+inline constexpr double geometric_tolerance = 1e-10;
+
+/// The length scale of a set of points (x: (points, gdim), row-major): the
+/// larger of the largest coordinate magnitude and the bounding box diagonal.
+/// Round-off in lengths grows with the first, real sizes with the second.
+double
+length_scale(std::span<const double> x, int gdim);
+
+/// The length below which a length is judged zero: geometric_tolerance *
+/// length_scale(x, gdim), never below the smallest normal double.
+double
+zero_length(std::span<const double> x, int gdim);
+
+} // namespace dolfinx_mortar
