@@ -223,7 +223,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
 
         def cell_normal(nodes: list, degree: int, X: Value) -> list:
             t = _combine(line_basis(degree, X)[1], nodes)
-            return _unit([t[1], -t[0]])
+            return [t[1], -t[0]]    # size-weighted, as the kernel's
 
         # averaged nodal normals at the slave cell's nodes (element_node_normals + average)
         normals = []

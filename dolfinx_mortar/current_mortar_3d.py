@@ -128,12 +128,12 @@ def pair_gap_3d(values: FloatArray, normal_cells: list, num_slave_nodes: int,
     v = Jet.variables(values[None, :])
     nodes = [v[3 * i:3 * i + 3] for i in range(len(values) // 3)]
     own, master = nodes[:3], nodes[num_slave_nodes:num_slave_nodes + 3]
-    # every triangle's unit normal at once (a batch over the patch's triangles),
-    # then the vertex averages
+    # every triangle's area-weighted normal at once (a batch over the patch's
+    # triangles), then the vertex averages, as the kernel's size-weighted ones
     unique = sorted({cell for cells in normal_cells for cell in cells})
     corners = [[stack([nodes[cell[k]][c] for cell in unique]) for c in range(3)]
                for k in range(3)]
-    cell_normals = _unit(_cross(_sub(corners[1], corners[0]), _sub(corners[2], corners[0])))
+    cell_normals = _cross(_sub(corners[1], corners[0]), _sub(corners[2], corners[0]))
     normals = []
     for cells in normal_cells:
         rows = [unique.index(cell) for cell in cells]

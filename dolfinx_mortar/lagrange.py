@@ -15,6 +15,7 @@ import numpy.typing as npt
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.layout import NodeLayout
 from dolfinx_mortar.tabulation import Tabulation
+from dolfinx_mortar.tolerance import GEOMETRIC_TOLERANCE, length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -173,7 +174,7 @@ class LagrangeSurface:
 
     def __init__(self, cell: str, degree: int, x: npt.ArrayLike, cells: npt.ArrayLike,
                  layout: Optional[NodeLayout] = None, serendipity: bool = False,
-                 quadratic_transform: bool = False):
+                 quadratic_transform: bool = False, check_cells: bool = True):
         self.reference = ReferenceLagrange(cell, degree, serendipity, quadratic_transform)
         self.x = np.asarray(x, dtype=np.float64)
         self.cells = np.asarray(cells, dtype=np.int64)
@@ -195,6 +196,50 @@ class LagrangeSurface:
         self.description = self.reference.name
         self.tdim = self.reference.tdim
         self.gdim = self.x.shape[1]
+        if check_cells:
+            self._check_degenerate_cells()
+
+    def _check_degenerate_cells(self) -> None:
+        """Refuse facets of zero size, and triangles or quadrilaterals of zero
+        height (collinear vertices), judged against the geometry's scale.
+
+        A zero-length cell measures 0, 5.6e-17 or 1.1e-16 at |x| = 1 depending
+        on the CPU's BLAS kernels, so it cannot be caught by its measure
+        being zero; downstream it gave dual coefficients of 1e16 or a
+        singular factorization with no hint at the mesh.
+        """
+        comm = self.layout.comm
+        message = self._degenerate_cells_message() if len(self.cells) else None
+        # every rank raises, so that none waits in a collective for the other
+        messages = [m for m in comm.allgather(message) if m] if comm.size > 1 else [message]
+        if messages and messages[0]:
+            raise ValueError(messages[0])
+
+    def _degenerate_cells_message(self) -> Optional[str]:
+        nv = {"interval": 2, "triangle": 3, "quadrilateral": 4}[self.reference.cell]
+        vertices = self.x[self.cells[:, :nv]]                      # (cells, nv, gdim)
+        zero = zero_length(length_scale(self.x))
+        offsets = vertices[:, :, None, :] - vertices[:, None, :, :]
+        size = np.linalg.norm(offsets, axis=-1).max(axis=(1, 2))  # largest vertex distance
+        bad = size <= zero
+        what = "zero length" if self.tdim == 1 else "zero size"
+        if self.tdim == 2 and not np.any(bad):
+            # twice the area of the vertex polygon from its diagonals (Basix
+            # quadrilateral order 0, 1, 3, 2), exact where sqrt(EG − F²) is not
+            if nv == 3:
+                d1, d2 = vertices[:, 1] - vertices[:, 0], vertices[:, 2] - vertices[:, 0]
+            else:
+                d1, d2 = vertices[:, 3] - vertices[:, 0], vertices[:, 2] - vertices[:, 1]
+            twice_area = np.linalg.norm(np.cross(d1, d2), axis=-1)
+            bad = twice_area / size <= zero      # the height over the longest distance
+            what = "collinear vertices (zero height)"
+        if not np.any(bad):
+            return None
+        c = int(np.flatnonzero(bad)[0])
+        return (f"degenerate facet: cell {c} of the {self.description} surface has {what} "
+                f"below {GEOMETRIC_TOLERANCE:g} × the geometry's length scale "
+                f"(vertices {vertices[c].tolist()}); {int(np.sum(bad))} such cell(s) on this "
+                "rank")
 
     @property
     def facet_type(self):
@@ -222,9 +267,11 @@ class LagrangeSurface:
         cells = self.cells.copy()
         which = np.asarray(which, dtype=bool)
         cells[which] = cells[which][:, self.reference.reflection]
+        # the same facets (checked already); callers reflect on some ranks only
         return LagrangeSurface(self.reference.cell, self.reference.degree, self.x, cells,
                                layout=self.layout, serendipity=self.reference.serendipity,
-                               quadratic_transform=self.reference.transform is not None)
+                               quadratic_transform=self.reference.transform is not None,
+                               check_cells=False)
 
     @property
     def num_elements(self) -> int:
@@ -283,11 +330,12 @@ class LagrangeSurface:
 
 
 def _measure_from_tangents(tangents: list) -> FloatArray:
-    """|t₀| (lines) or sqrt(|t₀|²|t₁|² − (t₀·t₁)²) (surfaces): det(JᵀJ) in closed form."""
+    """|t₀| (lines) or |t₀ × t₁| (surfaces, which live in 3D).
+
+    The cross product, not sqrt(|t₀|²|t₁|² − (t₀·t₁)²): that difference
+    cancels catastrophically on slivers (94% off at aspect 1e8).
+    """
     if len(tangents) == 1:
         return np.linalg.norm(tangents[0], axis=-1)
     t0, t1 = tangents
-    E = np.einsum("...g,...g->...", t0, t0)
-    F = np.einsum("...g,...g->...", t0, t1)
-    G = np.einsum("...g,...g->...", t1, t1)
-    return np.sqrt(np.maximum(E * G - F * F, 0.0))
+    return np.linalg.norm(np.cross(t0, t1), axis=-1)

@@ -75,17 +75,22 @@ def current_coordinates(surface: LagrangeSurface,
 def averaged_nodal_normals(surface: LagrangeSurface, x: FloatArray) -> FloatArray:
     """Unit averages of the adjacent cells' normals at every local node.
 
+    Each cell's normal is weighted by its size (|J| at the node: the length
+    of a P1 line, twice the area of a P1 triangle), so that a facet of
+    vanishing size, as mesh generators make at corners, cannot tilt its
+    nodes' normals (unweighted, a 1e-6 h facet at 45° tilted them by 22°).
     Nodes on no cell get a zero vector. Summed across ranks, so a node shared
     by facets on two ranks gets the same normal on both.
     """
     cell_normals = _kernels.element_node_normals(surface.facet_type, x,
-                                                 surface.cells.astype(np.int32))
+                                                 surface.cells.astype(np.int32),
+                                                 size_weighted=True)
     summed = np.column_stack([surface.layout.sum_at_functions(surface.cells,
                                                               cell_normals[..., k])
                               for k in range(x.shape[1])])
     length = np.linalg.norm(summed, axis=1)
     return np.divide(summed, length[:, None], out=np.zeros_like(summed),
-                     where=length[:, None] > 0)
+                     where=length[:, None] > 0)  # exactly 0 only on nodes of no cell
 
 
 def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:

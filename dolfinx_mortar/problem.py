@@ -25,6 +25,7 @@ from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_
 from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
 from dolfinx_mortar.current_mortar import CurrentMortarGap
 from dolfinx_mortar.finite_deformation import CurrentObstacleGap, CurrentState, CurrentSurfaceGap
+from dolfinx_mortar.input_checks import check_boundary_data, check_cells, unused_petsc_options
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, parse_kind
 from dolfinx_mortar.mortar import MortarCoupling
 from dolfinx_mortar.layout import assemble_blocks
@@ -35,6 +36,10 @@ from dolfinx_mortar.surface_output import SlaveSurfaceOutput, surface_output_pat
 FloatArray = npt.NDArray[np.float64]
 
 ACTIVE_SETS = ("nodal", "pointwise")
+#: above this Poisson's ratio linear elements lock (warned about)
+NEARLY_INCOMPRESSIBLE = 0.45
+#: an initial penetration deeper than this many slave element lengths is warned about
+DEEP_PENETRATION = 0.5
 CONFIGURATIONS = ("initial", "previous", "current")
 
 #: PETSc options set unless the options database already has them
@@ -192,11 +197,17 @@ class ContactProblem:
         gdim = mesh.geometry.dim
         if V.dofmap.index_map_bs != gdim:
             raise ValueError(f"V must be a vector space with {gdim} components per node")
+        check_cells(mesh)
         if (master_tag is None) == (obstacle is None):
             raise ValueError("give exactly one of master_tag (elastic master) and obstacle "
                              "(rigid analytic obstacle)")
-        if not (E > 0 and -1 < nu < 0.5):
-            raise ValueError(f"need E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
+        if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
+            raise ValueError(f"need a finite E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
+        if nu > NEARLY_INCOMPRESSIBLE and V.ufl_element().degree() == 1:
+            warnings.warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
+                          "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the contact "
+                          "force of nu = 0.3); use quadratic elements or a mixed form",
+                          RuntimeWarning, stacklevel=2)
         if active_set not in ACTIVE_SETS:
             raise ValueError(f"unknown active set '{active_set}'; expected {ACTIVE_SETS}")
         if basis_configuration not in CONFIGURATIONS:
@@ -224,9 +235,16 @@ class ContactProblem:
                           "curved contact tested (Hertz 2D); prefer active_set='nodal'",
                           RuntimeWarning, stacklevel=2)
         fixed, tractions = fixed or {}, tractions or {}
+        check_boundary_data(fixed, tractions, gdim)
+        if not np.issubdtype(np.asarray(facet_tags.values).dtype, np.integer):
+            raise TypeError(f"facet tag values must be integers, got "
+                            f"{np.asarray(facet_tags.values).dtype}")
         present = {int(t) for values in mesh.comm.allgather(np.unique(facet_tags.values))
                    for t in values}
         for tag in [slave_tag, master_tag, *fixed, *tractions]:
+            if tag is not None and not isinstance(tag, (int, np.integer)):
+                raise TypeError(f"tags must be integers, got {tag!r} "
+                                f"({type(tag).__name__})")
             if tag is not None and tag not in present:
                 raise ValueError(f"facet tag {tag} marks no facets (tags present: "
                                  f"{sorted(present)})")
@@ -260,8 +278,6 @@ class ContactProblem:
         F = ufl.inner(sigma(self.u), eps(v)) * ufl.dx
         for tag, t in tractions.items():
             t = np.asarray(t, dtype=np.float64)
-            if t.shape != (gdim,):
-                raise ValueError(f"traction on tag {tag} must have {gdim} components")
             F -= self.load * ufl.inner(ufl.as_vector([float(c) for c in t]), v) * ds(tag)
         self.F_form = fem.form(F)
         self.J_form = fem.form(ufl.derivative(F, self.u, du))
@@ -272,8 +288,6 @@ class ContactProblem:
         for tag, components in fixed.items():
             facets = facet_tags.find(tag)
             for k, value in components.items():
-                if not 0 <= k < gdim:
-                    raise ValueError(f"component {k} does not exist in {gdim}D")
                 dofs = fem.locate_dofs_topological(V.sub(k), fdim, facets)
                 c = fem.Constant(mesh, PETSc.ScalarType(0.0))
                 self._bc_values.append((c, float(value)))
@@ -288,6 +302,35 @@ class ContactProblem:
         self.A_bulk = fem_petsc.create_matrix(self.J_form)
         self.timings: dict[str, float] = {}
         self._output: Optional[Path] = None
+        self._warn_deep_initial_penetration()
+
+    def _warn_deep_initial_penetration(self) -> None:
+        """Warn when the initial configuration already penetrates by more than
+        DEEP_PENETRATION slave element lengths (a rigid plane placed 0.2 deep
+        into a 0.5-high block solved without a word)."""
+        gaps = self.nodal_gaps()
+        n = self.slave.layout.num_owned
+        W = self.gap_model.lumped_weights
+        covered = self.gap_model.covered & (W > 0)
+        length = np.power(np.where(covered, W, 1.0), 1.0 / self.slave.tdim)
+        depth = np.where(covered, gaps / length, -np.inf)[:n]
+        worst = int(np.argmax(depth)) if n else -1
+        local = (float(depth[worst]), float(gaps[worst]), self.slave.x[worst].tolist()) \
+            if n else (-np.inf, 0.0, [])
+        ratio, gap, x = max(self.mesh.comm.allgather(local), key=lambda item: item[0])
+        if ratio > DEEP_PENETRATION:
+            warnings.warn(f"the initial configuration penetrates by {gap:.3g} ({ratio:.3g} "
+                          f"slave element lengths) at the slave node {x}: check the "
+                          "obstacle's position and normal, or the tags of slave and master",
+                          RuntimeWarning, stacklevel=3)
+
+    def _check_petsc_options(self, prefix: str) -> None:
+        """Refuse options under the prefix that no PETSc object read (misspelled)."""
+        unused = unused_petsc_options(prefix, ignore=DEFAULT_OPTIONS)
+        if unused:
+            raise ValueError(f"PETSc option(s) {', '.join(unused)} were set but not used by "
+                             f"any solver of this problem: misspelled, or meant for another "
+                             f"prefix? (options prefix '{prefix}')")
 
     # -- contact -------------------------------------------------------------------
     def _segment(self, u_nodes: Optional[FloatArray]) -> None:
@@ -636,6 +679,7 @@ class ContactProblem:
             finally:
                 if current is not None:
                     self.gap_model = current
+            self._check_petsc_options(snes.getOptionsPrefix())
             reason = snes.getConvergedReason()
             history += list(snes.getConvergenceHistory()[0])
             iterations += snes.getIterationNumber()

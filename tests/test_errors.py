@@ -45,11 +45,28 @@ def test_kinds_without_lumped_weights_work_on_plain_quadratic_triangles(kind):
     assert np.all(np.isfinite(b.nodal_values(lambda x: 1.0 + x[0])))
 
 
-def test_degenerate_facet_is_reported():
-    x = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
-    surface = LagrangeSurface("interval", 1, x, [[0, 1], [1, 2], [2, 3]])
-    with pytest.raises(ValueError, match="degenerate slave element: cell 1"):
-        MortarBasis("LcLS*", surface)
+@pytest.mark.parametrize("scale", [1.0, 1e4, 1e-4])
+def test_zero_length_facet_is_reported(scale):
+    """Whatever the CPU: this cell's computed measure is 0, 5.6e-17 or 1.1e-16
+    depending on the BLAS kernels (OPENBLAS_CORETYPE), 1.8e-12 at |x| = 1e4."""
+    x = scale * np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    with pytest.raises(ValueError, match="degenerate facet: cell 1 .*zero length"):
+        LagrangeSurface("interval", 1, x, [[0, 1], [1, 2], [2, 3]])
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e4])
+def test_collinear_triangle_is_reported(offset):
+    x = offset + np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 1e-15], [0, 1, 0], [1, 1, 0]])
+    with pytest.raises(ValueError, match="degenerate facet: cell 1 .*collinear"):
+        LagrangeSurface("triangle", 1, x, [[0, 1, 3], [0, 1, 2], [1, 4, 3]])
+
+
+def test_sliver_triangle_is_not_degenerate_and_its_area_is_exact():
+    """Aspect 1e8 is a real (if poor) facet: accepted, with the cross-product area."""
+    x = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, 1e-8, 0]])
+    surface = LagrangeSurface("triangle", 1, x, [[0, 1, 2]])
+    area = surface.tabulate().weights.sum()
+    assert area == pytest.approx(0.5e-8, rel=1e-12)
 
 
 def test_nan_field_is_reported():

@@ -230,8 +230,8 @@ def test_bad_input_is_reported():
     plane = RigidPlane([0, 0], [0, 1])
     with pytest.raises(ValueError, match="penalty must be positive"):
         ContactProblem(V, tags, 1, obstacle=plane, penalty=-1.0, **common)
-    with pytest.raises(ValueError, match="unknown mortar basis kind 'Dual'"):
-        ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, kind="Dual", **common)
+    with pytest.raises(ValueError, match="unknown mortar basis kind 'Duall'"):
+        ContactProblem(V, tags, 1, obstacle=plane, penalty=1.0, kind="Duall", **common)
     with pytest.raises(ValueError, match="facet tag 9 marks no facets"):
         ContactProblem(V, tags, 9, obstacle=plane, penalty=1.0, **common)
     with pytest.raises(ValueError, match="overlap"):

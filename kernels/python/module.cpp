@@ -221,15 +221,21 @@ PYBIND11_MODULE(_kernels, m)
 
   m.def(
     "element_node_normals",
-    [](FacetType type, const array_t& x, const int_array_t& cells)
+    [](FacetType type,
+       const array_t& x,
+       const int_array_t& cells,
+       bool size_weighted)
     {
       auto s = surface_view(type, x, cells);
-      return to_numpy(element_node_normals(s),
+      return to_numpy(element_node_normals(s, size_weighted),
                       { cells.shape(0), cells.shape(1), x.shape(1) });
     },
     py::arg("type"),
     py::arg("x"),
-    py::arg("cells"));
+    py::arg("cells"),
+    py::arg("size_weighted") = false,
+    "Normal of every cell at its nodes (cells, nodes, gdim): unit, or of "
+    "length |J| with size_weighted");
 
   m.def(
     "facet_bounding_boxes",

@@ -2,6 +2,10 @@
 // SPDX-License-Identifier: MIT
 #include <dolfinx_mortar/basis_kind.h>
 
+#include <algorithm>
+#include <cctype>
+#include <string>
+
 #include <stdexcept>
 
 namespace dolfinx_mortar
@@ -31,19 +35,29 @@ to_string(BasisKind kind)
 BasisKind
 basis_kind_from_string(std::string_view name)
 {
+  // Case-insensitive: the six names differ beyond case, and users type
+  // "gls" as readily as "dual"; one rule for names and aliases alike.
+  auto lower = [](std::string_view s)
+  {
+    std::string out(s);
+    std::transform(out.begin(), out.end(), out.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
+    return out;
+  };
+  const std::string key = lower(name);
   for (BasisKind kind : all_basis_kinds)
-    if (name == to_string(kind))
+    if (key == lower(to_string(kind)))
       return kind;
-  if (name == "standard")
+  if (key == "standard")
     return BasisKind::LmLS_star;
-  if (name == "weighted")
+  if (key == "weighted")
     return BasisKind::LmLS;
-  if (name == "dual")
+  if (key == "dual")
     return BasisKind::LcLS_star;
   throw std::invalid_argument(
     "unknown mortar basis kind '" + std::string(name) +
     "'; valid kinds are GLS, GLS*, LmLS, LmLS*, LcLS*, LcLS and the "
-    "aliases standard (LmLS*), weighted (LmLS), dual (LcLS*)");
+    "aliases standard (LmLS*), weighted (LmLS), dual (LcLS*), in any case");
 }
 
 bool

@@ -55,15 +55,19 @@ facet_geometry(const FacetSurface& s,
 }
 
 Point3
+size_weighted_normal(int gdim, const std::array<Point3, 2>& t)
+{
+  if (gdim == 2)
+    return { t[0][1], -t[0][0], 0 };
+  return { t[0][1] * t[1][2] - t[0][2] * t[1][1],
+           t[0][2] * t[1][0] - t[0][0] * t[1][2],
+           t[0][0] * t[1][1] - t[0][1] * t[1][0] };
+}
+
+Point3
 normal_from_tangents(int gdim, const std::array<Point3, 2>& t)
 {
-  Point3 n;
-  if (gdim == 2)
-    n = { t[0][1], -t[0][0], 0 };
-  else
-    n = { t[0][1] * t[1][2] - t[0][2] * t[1][1],
-          t[0][2] * t[1][0] - t[0][0] * t[1][2],
-          t[0][0] * t[1][1] - t[0][1] * t[1][0] };
+  Point3 n = size_weighted_normal(gdim, t);
   const double norm = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   if (norm > 0)
     for (double& v : n)
@@ -97,7 +101,7 @@ facet_reference_nodes(FacetType type)
 }
 
 std::vector<double>
-element_node_normals(const FacetSurface& s)
+element_node_normals(const FacetSurface& s, bool size_weighted)
 {
   s.check();
   const int nn = facet_num_nodes(s.type), tdim = facet_tdim(s.type);
@@ -110,7 +114,8 @@ element_node_normals(const FacetSurface& s)
     {
       facet_geometry(
         s, c, std::span(nodes.data() + i * tdim, tdim), N, dN, x, t);
-      const Point3 n = normal_from_tangents(s.gdim, t);
+      const Point3 n = size_weighted ? size_weighted_normal(s.gdim, t)
+                                     : normal_from_tangents(s.gdim, t);
       std::copy_n(n.begin(), s.gdim, out.begin() + (c * nn + i) * s.gdim);
     }
   return out;

@@ -17,6 +17,11 @@ TEST(BasisKind, Aliases)
   EXPECT_EQ(basis_kind_from_string("standard"), BasisKind::LmLS_star);
   EXPECT_EQ(basis_kind_from_string("weighted"), BasisKind::LmLS);
   EXPECT_EQ(basis_kind_from_string("dual"), BasisKind::LcLS_star);
+  // any case, names and aliases alike
+  EXPECT_EQ(basis_kind_from_string("gls"), BasisKind::GLS);
+  EXPECT_EQ(basis_kind_from_string("lcls*"), BasisKind::LcLS_star);
+  EXPECT_EQ(basis_kind_from_string("LMLS"), BasisKind::LmLS);
+  EXPECT_EQ(basis_kind_from_string("Dual"), BasisKind::LcLS_star);
 }
 
 TEST(BasisKind, UnknownNameThrowsWithName)

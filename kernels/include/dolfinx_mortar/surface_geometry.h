@@ -38,6 +38,11 @@ facet_geometry(const FacetSurface& s,
                Point3& x,
                std::array<Point3, 2>& tangents);
 
+/// Normal from tangents with length |J| (2D: (t_y, -t_x), 3D: t0 × t1; only
+/// tangents[0] is used in 2D).
+Point3
+size_weighted_normal(int gdim, const std::array<Point3, 2>& tangents);
+
 /// Unit normal from tangents (2D: only tangents[0] is used).
 Point3
 normal_from_tangents(int gdim, const std::array<Point3, 2>& tangents);
@@ -46,10 +51,14 @@ normal_from_tangents(int gdim, const std::array<Point3, 2>& tangents);
 std::vector<double>
 facet_reference_nodes(FacetType type);
 
-/// Unit normal of each cell at each of its nodes, (cells, nodes, gdim).
-/// Averaging them per node gives the averaged nodal normals of DESIGN.md §3.
+/// Normal of each cell at each of its nodes, (cells, nodes, gdim): unit, or
+/// with @p size_weighted of length |J| at the node (the facet's length or
+/// twice its area on P1 cells). Summing the size-weighted ones per node and
+/// normalizing gives the averaged nodal normals of DESIGN.md §3, which a
+/// facet of vanishing size cannot tilt (unit normals gave a 1e-6 h facet at
+/// 45° the same say as its neighbour: 22° of tilt).
 std::vector<double>
-element_node_normals(const FacetSurface& s);
+element_node_normals(const FacetSurface& s, bool size_weighted = false);
 
 /// Bounding box of each cell's nodes enlarged by @p margin, (cells, 6).
 std::vector<double>

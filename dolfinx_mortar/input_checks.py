@@ -1,0 +1,139 @@
+"""Checks of the user's input that name the problem (DOLFINx 0.5.2, PETSc 3.18).
+
+Bad input must fail early with a message that points at the offending entity,
+not later inside FFCx, the compiler or MUMPS.
+"""
+from __future__ import annotations
+
+import ctypes
+from typing import Iterable, Optional
+
+import dolfinx
+import numpy as np
+from petsc4py import PETSc
+
+from dolfinx_mortar.tolerance import length_scale, zero_length
+
+
+def check_boundary_data(fixed: dict, tractions: dict, gdim: int) -> None:
+    """Prescribed components and tractions: valid components, finite values.
+
+    Raises
+    ------
+    ValueError
+        Naming the tag and component of a bad entry (a NaN traction used to
+        end in an FFCx IndexError, a NaN prescribed value in six failed
+        attempts with an empty residual list).
+    """
+    for tag, components in fixed.items():
+        if not isinstance(components, dict):
+            raise TypeError(f"fixed[{tag}] must be a dict {{component: value}}, "
+                            f"got {components!r}")
+        for k, value in components.items():
+            if not isinstance(k, (int, np.integer)) or not 0 <= k < gdim:
+                raise ValueError(f"fixed[{tag}]: component {k!r} does not exist in {gdim}D")
+            if not np.isfinite(float(value)):
+                raise ValueError(f"fixed[{tag}][{k}] = {value}: a prescribed displacement "
+                                 "must be finite")
+    for tag, t in tractions.items():
+        t = np.asarray(t, dtype=np.float64)
+        if t.shape != (gdim,):
+            raise ValueError(f"traction on tag {tag} must have {gdim} components, "
+                             f"got shape {t.shape}")
+        if not np.all(np.isfinite(t)):
+            raise ValueError(f"traction on tag {tag} is {t.tolist()}: it must be finite")
+
+
+def check_cells(mesh: dolfinx.mesh.Mesh) -> None:
+    """Refuse cells of zero size and tangled (folded) cells.
+
+    Across every facet that two local cells share, their centroids must lie
+    on opposite sides of the facet, each further than the zero length
+    (:mod:`dolfinx_mortar.tolerance`) from it. Exact for simplices; for
+    quadrilaterals and hexahedra the facet's plane is that of its first
+    three vertices. Facets on a partition boundary with no ghost cell are not
+    seen by either rank.
+
+    Raises
+    ------
+    ValueError
+        Naming the two cells and the facet's vertices.
+    """
+    message = _bad_cells_message(mesh) if mesh.geometry.dim == mesh.topology.dim else None
+    # every rank raises, so that none waits in a collective for the other
+    messages = [m for m in mesh.comm.allgather(message) if m]
+    if messages:
+        raise ValueError(messages[0])
+
+
+def _bad_cells_message(mesh: dolfinx.mesh.Mesh) -> Optional[str]:
+    tdim = mesh.topology.dim
+    fdim = tdim - 1
+    gdim = mesh.geometry.dim
+    mesh.topology.create_connectivity(fdim, tdim)
+    f2c = mesh.topology.connectivity(fdim, tdim)
+    interior = np.flatnonzero(np.diff(f2c.offsets) == 2).astype(np.int32)
+    if len(interior) == 0:
+        return None
+    cells = f2c.array[f2c.offsets[interior][:, None] + np.arange(2)]      # (facets, 2)
+    x = mesh.geometry.x[:, :gdim]
+    geometry = mesh.geometry.dofmap
+    cell_nodes = geometry.array.reshape(-1, geometry.offsets[1])
+    # the facets' vertices' geometry nodes (the first nodes of a facet's closure)
+    facet_nodes = dolfinx.cpp.mesh.entities_to_geometry(mesh._mesh, fdim, interior, False)
+    corners = x[facet_nodes[:, :tdim]]                                       # (f, tdim, gdim)
+    if gdim == 2:
+        t = corners[:, 1] - corners[:, 0]
+        normal = np.column_stack([t[:, 1], -t[:, 0]])
+    else:
+        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    length = np.linalg.norm(normal, axis=1)
+    num_vertices = dolfinx.cpp.mesh.cell_num_entities(mesh.topology.cell_type, 0)
+    centroids = x[cell_nodes[cells][..., :num_vertices]].mean(axis=2)       # (f, 2, gdim)
+    zero = zero_length(length_scale(x))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        side = np.einsum("fcg,fg->fc", centroids - corners[:, None, 0], normal) / length[:, None]
+    degenerate = ~(np.abs(side) > zero).all(axis=1)
+    folded = ~degenerate & (np.sign(side[:, 0]) == np.sign(side[:, 1]))
+    for bad, what in ((degenerate, "a cell of zero size (or a degenerate facet)"),
+                      (folded, "tangled cells (both on the same side of their shared facet)")):
+        if np.any(bad):
+            f = int(np.flatnonzero(bad)[0])
+            return (f"the mesh has {what}: local cells {cells[f].tolist()} across the facet "
+                    f"with vertices {corners[f].tolist()}; {int(np.sum(bad))} such facet(s) "
+                    f"on rank {mesh.comm.rank}")
+    return None
+
+
+def _petsc_library() -> Optional[ctypes.CDLL]:
+    major, minor, _ = PETSc.Sys.getVersion()
+    for name in (f"libpetsc_real.so.{major}.{minor}", f"libpetsc.so.{major}.{minor}"):
+        try:
+            return ctypes.CDLL(name)
+        except OSError:
+            continue
+    return None
+
+
+def unused_petsc_options(prefix: str, ignore: Iterable[str] = ()) -> list[str]:
+    """Options under ``prefix`` in PETSc's database that no object has read.
+
+    petsc4py 3.18 does not expose ``PetscOptionsUsed``; it is called through
+    ctypes on the library petsc4py itself loaded. ``ignore`` names options
+    (without the prefix) that may stay unused, e.g. defaults for a solver
+    the user replaced. Returns [] when the library cannot be found.
+    """
+    lib = _petsc_library()
+    if lib is None:
+        return []
+    used_query = lib.PetscOptionsUsed
+    used_query.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
+    skip = {prefix + name for name in ignore}
+    unused = []
+    for name in PETSc.Options().getAll():
+        if not name.startswith(prefix) or name in skip:
+            continue
+        used = ctypes.c_int(0)
+        if used_query(None, name.encode(), ctypes.byref(used)) == 0 and not used.value:
+            unused.append("-" + name)
+    return sorted(unused)
