@@ -131,7 +131,7 @@ class ObstacleGap(_GapBase):
         #: M̄_A at the quadrature points, per cell: (cells, points, functions)
         self.Mbar = np.einsum("cqb,cba->cqa", tab.phi, self.coefficients_std)
         #: slave nodes with something below them (here: all; the obstacle is unbounded)
-        self.covered = self.basis.lumped_weights > 0
+        self.covered = slave.layout.on_cells(slave.cells)
 
     def evaluate(self, u_nodes: FloatArray) -> tuple[FloatArray, PETSc.Mat, FloatArray]:
         """Nodal gaps, G, and the obstacle Hessian data at the quadrature points.
@@ -206,8 +206,7 @@ class MortarGap(_GapBase):
         slave_cells = self.slave.cells[coupling.pairs[:, 0]]
         self.gaps0 = self.slave.layout.sum_at_functions(slave_cells, g0)
         #: slave nodes with master below them; the others have no gap at all
-        self.covered = self.slave.layout.sum_at_functions(
-            slave_cells, np.ones(slave_cells.shape)) > 0
+        self.covered = self.slave.layout.on_cells(slave_cells)
         n = coupling.normals[slave_cells]                      # (pairs, ns, gdim)
         master_nodes = coupling.master_global_ids[coupling.master_cells[coupling.pairs[:, 1]]]
         bs = self.slave.gdim

@@ -299,7 +299,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
         grad = np.einsum("pbn,ba->pan", grad, self.C)
         hess = np.einsum("pbmn,ba->pamn", hess, self.C)
         g = layout.sum_at_functions(cells, value)
-        self.covered = layout.sum_at_functions(cells, np.ones(cells.shape)) > 0
+        self.covered = layout.on_cells(cells)
         G_g = assemble_blocks(layout, cells, self.dofs, dofs, grad)
         return g, G_g, {"cells": cells, "dofs": dofs, "hess": hess, "value": value}
 

@@ -127,7 +127,7 @@ class CurrentSurfaceGap(_GapBase):
         #: exponents of y = ĝ W^{-k} and ω = ε W^m
         self.k = 0 if (scaling == "seed" and is_partition_of_unity(self.kind)) else 1
         self.m = 1 if scaling == "consistent" else 0
-        self.covered = self.basis.lumped_weights > 0
+        self.covered = slave.layout.on_cells(slave.cells)
         cells, gdim = slave.cells, slave.gdim
         nc, nd = cells.shape
         #: local and global dofs of every slave cell's nodes, (cells, nd·gdim)

@@ -247,7 +247,7 @@ class MortarCoupling:
             nd = slave.cells.shape[1]
             L = np.zeros((len(slave.cells), nd, nd))
             np.add.at(L, self.pairs[:, 0], self.D_pairs)
-            covered = np.flatnonzero(self.covered_area > 0)
+            covered = np.unique(self.pairs[:, 0])   # the kernel keeps pairs of positive area
             W = slave.layout.sum_at_functions(slave.cells[covered], L[covered].sum(axis=2))
             self._covered_mass = (L, covered, W)
         return self._covered_mass
@@ -307,7 +307,7 @@ class MortarCoupling:
                                 slave.layout.global_indices[rows], D, unit_diagonal=True)
         M_mat = assemble_blocks(slave.layout, rows, master_layout, master_cols, M)
         gap = slave.layout.sum_at_functions(rows, g)
-        touched = slave.layout.sum_at_functions(rows, np.ones(rows.shape)) > 0
+        touched = slave.layout.on_cells(rows)
         return MortarOperators(kind, basis, D_mat, M_mat, gap, touched)
 
 

@@ -309,11 +309,17 @@ class ContactProblem:
         DEEP_PENETRATION slave element lengths (a rigid plane placed 0.2 deep
         into a 0.5-high block solved without a word)."""
         gaps = self.nodal_gaps()
-        n = self.slave.layout.num_owned
-        W = self.gap_model.lumped_weights
-        covered = self.gap_model.covered & (W > 0)
-        length = np.power(np.where(covered, W, 1.0), 1.0 / self.slave.tdim)
-        depth = np.where(covered, gaps / length, -np.inf)[:n]
+        slave = self.slave
+        n = slave.layout.num_owned
+        # each node's length: the largest of its local cells' (measure^(1/tdim))
+        cell_length = slave.tabulate().weights.sum(axis=1) ** (1.0 / slave.tdim)
+        length = np.zeros(slave.layout.size_local)
+        np.maximum.at(length, slave.cells, np.repeat(cell_length[:, None],
+                                                     slave.cells.shape[1], axis=1))
+        on_local_cell = np.zeros(slave.layout.size_local, dtype=bool)
+        on_local_cell[slave.cells] = True
+        covered = self.gap_model.covered & on_local_cell
+        depth = np.where(covered, gaps / np.where(covered, length, 1.0), -np.inf)[:n]
         worst = int(np.argmax(depth)) if n else -1
         local = (float(depth[worst]), float(gaps[worst]), self.slave.x[worst].tolist()) \
             if n else (-np.inf, 0.0, [])
