@@ -452,11 +452,17 @@ def grazing(kind: str, force: float = 0.01, shear: float = 0.1, h_contact: float
 LOWER_TOP, UPPER_BOTTOM, TOP, BOTTOM, SYM_X, SYM_Y = 1, 2, 3, 4, 5, 6
 
 
-def stacked_boxes(cell: str, n: int, mirror_upper: bool, comm: MPI.Comm):
+def stacked_boxes(cell: str, n: int, mirror_upper: bool, comm: MPI.Comm,
+                  noise: float = 0.0, seed: int = 0):
     """Two unit blocks [0,1]²×[−½,0] and [0,1]²×[0,½] in one mesh, not joined:
     their interface meshes are identical (coincident nodes and edges). With
     ``mirror_upper`` the upper block is mirrored in x, so that its interface
-    triangles have the other diagonal (coincident nodes, crossing edges)."""
+    triangles have the other diagonal (coincident nodes, crossing edges).
+
+    ``noise`` moves the upper block's interface nodes in the interface plane by
+    up to ``noise`` times the element size, as two separately meshed conforming
+    faces differ by round-off. The motion is in-plane: a normal one would be a
+    real gap, which the penalty turns into a pressure change ε·δ."""
     import ufl
     from dolfinx import mesh
     cell_type = {"tetrahedron": mesh.CellType.tetrahedron,
@@ -468,6 +474,10 @@ def stacked_boxes(cell: str, n: int, mirror_upper: bool, comm: MPI.Comm):
         x = block.geometry.x.copy()
         if mirror:
             x[:, 0] = 1.0 - x[:, 0]
+        if z0 == 0.0 and noise > 0:
+            on = x[:, 2] == 0.0
+            rng = np.random.default_rng(seed)
+            x[on, :2] += noise / n * rng.uniform(-1.0, 1.0, (int(on.sum()), 2))
         cells = block.geometry.dofmap.array.reshape(block.topology.index_map(3).size_local, -1)
         if mirror and cell == "tetrahedron":
             cells = cells[:, [1, 0, 2, 3]]   # keep a positive orientation
@@ -504,13 +514,14 @@ def stacked_boxes(cell: str, n: int, mirror_upper: bool, comm: MPI.Comm):
 
 
 def coincident_patch(kind: str, cell: str = "tetrahedron", mirror_upper: bool = False,
-                     n: int = 4, pressure: float = 0.01) -> dict:
-    """Patch test on two stacked blocks with coincident interface meshes."""
+                     n: int = 4, pressure: float = 0.01, noise: float = 0.0) -> dict:
+    """Patch test on two stacked blocks with coincident interface meshes (up to
+    in-plane ``noise`` relative to the element size on the master's nodes)."""
     from dolfinx import fem
     from dolfinx_mortar.mortar import MortarCoupling
     from dolfinx_mortar.problem import ContactProblem
     comm = MPI.COMM_WORLD
-    domain, tags = stacked_boxes(cell, n, mirror_upper, comm)
+    domain, tags = stacked_boxes(cell, n, mirror_upper, comm, noise=noise)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
     h = 1.0 / n
     problem = ContactProblem(V, tags, LOWER_TOP, master_tag=UPPER_BOTTOM, E=1.0, nu=0.3,
@@ -522,6 +533,7 @@ def coincident_patch(kind: str, cell: str = "tetrahedron", mirror_upper: bool = 
     coupling = MortarCoupling(problem.slave, problem.master)
     return {"case": "coincident", "kind": kind,
             "variant": f"{cell}{'-crossing' if mirror_upper else ''}",
+            "noise": noise,
             "max_relative_deviation": float(np.max(np.abs(p / pressure - 1.0))),
             "area_error": abs(coupling.total_covered_area - 1.0),
             "failed_projections": coupling.failed_projections,

@@ -41,8 +41,6 @@ Value = Union[Jet, FloatArray, float]
 LINE_NODES = {1: (0.0, 1.0), 2: (0.0, 1.0, 0.5)}
 #: flat pieces the kernel splits a line into (facet_subfacets in facet_element.cpp)
 LINE_PIECES = {1: ((0.0, 1.0),), 2: ((0.0, 0.5), (0.5, 1.0))}
-#: a pair's overlap shorter than this times the slave piece counts as none (the kernel's)
-RELATIVE_TOLERANCE = 1e-12
 
 
 def line_basis(degree: int, X: Value) -> tuple[list, list]:
@@ -234,6 +232,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
                 n = [n[0] + m[0] * has_other[:, a], n[1] + m[1] * has_other[:, a]]
             normals.append(_unit(n))
 
+        # an overlap no longer than the zero length counts as none (the kernel's
+        # decision, against the same length scale)
+        zero = self.coupling.zero_length
         acc: list = [0.0] * ns
         for X0, X1 in LINE_PIECES[ps]:
             p0 = _combine(line_basis(ps, X0)[0], own)
@@ -255,8 +256,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
                 lo = maximum(s0, minimum(m0, m1))
                 hi = minimum(s1, maximum(m0, m1))
                 length = hi - lo
-                on = (opposing & (length.value > RELATIVE_TOLERANCE * size.value)
-                      ).astype(np.float64)
+                on = (opposing & (length.value > zero)).astype(np.float64)
                 for t, w in zip(self.segment_points[:, 0], self.segment_weights):
                     s = lo + length * t
                     x = [centre[0] + e1[0] * s, centre[1] + e1[1] * s]

@@ -28,9 +28,6 @@ from dolfinx_mortar.mortar import MortarCoupling, gather_surface
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-#: the kernel's relative tolerance (SegmentationOptions::relative_tolerance)
-RELATIVE_TOLERANCE = 1e-12
-
 
 def _sub(a: list, b: list) -> list:
     return [x - y for x, y in zip(a, b)]
@@ -57,9 +54,23 @@ def _signed_area(polygon: list) -> Jet:
     return total * 0.5
 
 
+def _longest_edge(polygon: list) -> float:
+    return max(float(np.hypot(_value(q[0]) - _value(p[0]), _value(q[1]) - _value(p[1])))
+               for p, q in zip(polygon, polygon[1:] + polygon[:1]))
+
+
+def _classify(s, tolerance: float) -> int:
+    """+1 inside, -1 outside, 0 on the line (within the tolerance)."""
+    v = _value(s)
+    return 1 if v > tolerance else (-1 if v < -tolerance else 0)
+
+
 def clip_polygon(subject: list, clip: list, tolerance: float) -> list:
     """``clip_polygon`` of ``clipping.cpp`` on 2D points of Jets: the same
-    decisions, taken on the values, and the same merging of close points."""
+    decisions, taken on the values, and the same merging of close points.
+
+    Points within ``tolerance`` of a clip line are on it: kept, and never the
+    end of a crossing, so a crossing lies strictly inside its edge (t in (0, 1))."""
     output = list(subject)
     for e in range(len(clip)):
         if not output:
@@ -77,10 +88,10 @@ def clip_polygon(subject: list, clip: list, tolerance: float) -> list:
         for i, p in enumerate(points):
             q = points[(i + 1) % len(points)]
             sp, sq = side(p), side(q)
-            p_in, q_in = _value(sp) >= -tolerance, _value(sq) >= -tolerance
-            if p_in:
+            cp, cq = _classify(sp, tolerance), _classify(sq, tolerance)
+            if cp >= 0:
                 output.append(p)
-            if p_in != q_in:
+            if cp * cq < 0:
                 t = sp / (sp - sq)
                 output.append([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])])
 
@@ -107,7 +118,7 @@ def _project_on_triangle(nodes: list, x: list, e1: list, e2: list) -> tuple:
 
 
 def pair_gap_3d(values: FloatArray, normal_cells: list, num_slave_nodes: int,
-                points: FloatArray, weights: FloatArray,
+                points: FloatArray, weights: FloatArray, zero: float,
                 opposing_normals_only: bool = True) -> Optional[list]:
     """``c_a = ∫ N_a d`` of one slave–master triangle pair, as Jets.
 
@@ -122,6 +133,9 @@ def pair_gap_3d(values: FloatArray, normal_cells: list, num_slave_nodes: int,
         node indices (the averaged normal's cells).
     points, weights
         The triangle rule on each piece of the clip polygon's fan.
+    zero
+        The zero length of the kernel's decisions
+        (:attr:`MortarCoupling.zero_length`).
 
     Returns None when the pair does not overlap.
     """
@@ -158,10 +172,9 @@ def pair_gap_3d(values: FloatArray, normal_cells: list, num_slave_nodes: int,
     master_polygon = [plane(p) for p in master]
     if _value(_signed_area(master_polygon)) < 0:
         master_polygon.reverse()
-    size = abs(_value(_signed_area(slave_polygon)))
-    tol_length, tol_size = RELATIVE_TOLERANCE * np.sqrt(size), RELATIVE_TOLERANCE * size
-    clipped = clip_polygon(slave_polygon, master_polygon, tol_length)
-    if len(clipped) < 3 or _value(_signed_area(clipped)) <= tol_size:
+    clipped = clip_polygon(slave_polygon, master_polygon, zero)
+    # no wider than the zero length: a segment or a point (the kernel's test)
+    if len(clipped) < 3 or not 2 * _value(_signed_area(clipped)) > zero * _longest_edge(clipped):
         return None
     m = len(clipped)
     g = [sum((q[k] for q in clipped[1:]), clipped[0][k]) * (1.0 / m) for k in range(2)]
@@ -262,7 +275,8 @@ def pair_jets_3d(patches: TrianglePatches, slave, u_nodes: FloatArray,
         node_dofs = (ids[:, None] * 3 + np.arange(3)).ravel()
         dofs[p, :w] = node_dofs
         dofs[p, w:] = node_dofs[0]
-        c = pair_gap_3d(x, patches.normal_cells[s], len(patches.node_ids[s]), points, weights)
+        c = pair_gap_3d(x, patches.normal_cells[s], len(patches.node_ids[s]), points, weights,
+                        coupling.zero_length)
         if c is None:
             continue
         for a, ca in enumerate(c):

@@ -31,6 +31,7 @@ from dolfinx_mortar.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
+from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -148,6 +149,13 @@ class MortarCoupling:
     keep_points
         Also keep every segment quadrature point (weight, gap, normal, slave
         and master basis values) in :attr:`points`, for the pointwise active set.
+
+    Raises
+    ------
+    ValueError
+        On every rank, when a slave or master facet is degenerate (its length,
+        or its height in 3D, below :attr:`zero_length`), naming the facet and
+        its node coordinates; or when a coordinate is NaN or infinite.
     """
 
     def __init__(self, slave: LagrangeSurface, master: LagrangeSurface,
@@ -196,10 +204,18 @@ class MortarCoupling:
                                        + max(_polynomial_degree(slave),
                                              _polynomial_degree(master)))
         points, weights = _segment_quadrature(slave.tdim, degree)
+        #: the length scale of every geometric decision, the same on every rank
+        #: (the master copy is global, the slave's points are reduced)
+        self.length_scale = max(length_scale(xs, comm),
+                                length_scale(master_copy.x) if len(master_copy.x) else 0.0)
+        #: lengths at or below this are zero (DESIGN.md §6)
+        self.zero_length = zero_length(self.length_scale)
         r = _kernels.mortar_integrals(slave.facet_type, xs, slave_cells, self.normals,
                                       master.facet_type, master_copy.x, master_copy.cells,
                                       candidates, points, weights, opposing_normals_only,
+                                      length_scale=self.length_scale,
                                       keep_points=keep_points)
+        self._raise_on_degenerate_facets(r, xs, slave_cells, master_copy)
         self.timings["segmentation"] = time.perf_counter() - clock
         self.num_candidates = len(candidates)
         self.failed_projections = comm.allreduce(int(r["failed_projections"]))
@@ -226,6 +242,25 @@ class MortarCoupling:
                                         minlength=len(slave.cells))
         self._bases: dict[BasisKind, MortarBasis] = {}
         self._covered_mass: Optional[tuple] = None
+
+    def _raise_on_degenerate_facets(self, r: dict, xs: FloatArray, slave_cells,
+                                    master_copy: SurfaceCopy) -> None:
+        """A degenerate facet covers nothing: rather than let it vanish from the
+        integrals, stop on every rank with the facets named."""
+        comm = self.slave.layout.comm
+        lines = [f"slave facet {c} (local cell index on rank {comm.rank}) with nodes "
+                 f"{np.array2string(xs[slave_cells[c]], precision=17, separator=', ')}"
+                 for c in r["degenerate_slave_facets"][:5]]
+        lines = [line for rank_lines in comm.allgather(lines) for line in rank_lines]
+        # the master copy is the same on every rank: so is its list
+        lines += [f"master facet {c} (index in the gathered master surface) with nodes "
+                  f"{np.array2string(master_copy.x[master_copy.cells[c]], precision=17, separator=', ')}"
+                  for c in r["degenerate_master_facets"][:5]]
+        if lines:
+            raise ValueError(
+                f"degenerate contact facets (length or height at most the zero length "
+                f"{self.zero_length:.3g} = tolerance × length scale {self.length_scale:.3g}): "
+                + "; ".join(lines))
 
     @property
     def total_covered_area(self) -> float:

@@ -275,13 +275,13 @@ PYBIND11_MODULE(_kernels, m)
        const array_t& points,
        const array_t& weights,
        bool opposing_normals_only,
-       double relative_tolerance,
+       double length_scale,
        bool keep_points)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
       SegmentationOptions options{ opposing_normals_only,
-                                   relative_tolerance,
+                                   length_scale,
                                    keep_points };
       MortarIntegrals r;
       {
@@ -304,6 +304,12 @@ PYBIND11_MODULE(_kernels, m)
       out["gap"] = to_numpy(r.gap, { np, ns });
       out["area"] = to_numpy(r.area, { np });
       out["failed_projections"] = r.failed_projections;
+      out["degenerate_slave_facets"] = to_numpy_as<std::int32_t>(
+        r.degenerate_slave_facets,
+        { static_cast<py::ssize_t>(r.degenerate_slave_facets.size()) });
+      out["degenerate_master_facets"] = to_numpy_as<std::int32_t>(
+        r.degenerate_master_facets,
+        { static_cast<py::ssize_t>(r.degenerate_master_facets.size()) });
       if (keep_points)
       {
         const auto nq = static_cast<py::ssize_t>(r.point_pairs.size());
@@ -328,7 +334,7 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("points"),
     py::arg("weights"),
     py::arg("opposing_normals_only") = true,
-    py::arg("relative_tolerance") = 1e-12,
+    py::arg("length_scale") = 0.0,
     py::arg("keep_points") = false,
     "Segmentation and slave-basis mortar integrals per cell pair");
 }

@@ -41,18 +41,27 @@ clip_polygon(const std::vector<Point2>& subject,
     { return (ex * (p[1] - a[1]) - ey * (p[0] - a[0])) / length; };
     input.swap(output);
     output.clear();
+    // Points within the tolerance of the line are on it: kept, and never
+    // the end of a crossing. A crossing is computed only between points
+    // strictly on opposite sides beyond the tolerance, so t lies in (0, 1)
+    // and the crossing point on the edge p–q. (Classifying with the
+    // tolerance but intersecting without it put t outside [0, 1] for a
+    // point "inside" by tolerance yet outside in fact: crossing points
+    // extrapolated off the edge, and near-coincident facets covered up to
+    // 80 times the slave's area.)
+    auto classify = [tolerance](double s)
+    { return s > tolerance ? 1 : (s < -tolerance ? -1 : 0); };
     const std::size_t n = input.size();
     for (std::size_t i = 0; i < n; ++i)
     {
       const Point2& p = input[i];
       const Point2& q = input[(i + 1) % n];
       const double sp = side(p), sq = side(q);
-      const bool p_in = sp >= -tolerance, q_in = sq >= -tolerance;
-      if (p_in)
+      const int cp = classify(sp), cq = classify(sq);
+      if (cp >= 0)
         output.push_back(p);
-      if (p_in != q_in)
+      if (cp * cq < 0)
       {
-        // sp and sq differ in sign beyond the tolerance: no division by ~0
         const double t = sp / (sp - sq);
         output.push_back(
           { p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]) });

@@ -1,10 +1,12 @@
 // Copyright (C) 2026 dolfinx_mortar developers
 // SPDX-License-Identifier: MIT
 #include <dolfinx_mortar/clipping.h>
+#include <dolfinx_mortar/geometric_tolerance.h>
 #include <dolfinx_mortar/mortar_integrals.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 
@@ -45,12 +47,36 @@ struct SubFacet
   double size; // length (2D) or area (3D)
 };
 
+template<typename Point>
+double
+longest_edge(const std::vector<Point>& polygon)
+{
+  double longest = 0;
+  for (std::size_t i = 0; i < polygon.size(); ++i)
+  {
+    const Point& p = polygon[i];
+    const Point& q = polygon[(i + 1) % polygon.size()];
+    double d = 0;
+    for (std::size_t k = 0; k < p.size(); ++k)
+      d += (q[k] - p[k]) * (q[k] - p[k]);
+    longest = std::max(longest, std::sqrt(d));
+  }
+  return longest;
+}
+
+/// The flat piece of cell @p c over the reference polygon, or nothing when
+/// it is degenerate: its length (2D) or its height, twice its area over its
+/// longest edge (3D), at most @p zero. Judged against the geometry's zero
+/// length, not against the piece's own extent: a collinear triangle has a
+/// round-off area that grows with |x|, and a sliver 1e-8 of its length is
+/// real input.
 std::optional<SubFacet>
 make_subfacet(const FacetSurface& s,
               std::size_t c,
               const std::vector<std::array<double, 2>>& reference,
               std::span<double> N,
-              std::span<double> dN)
+              std::span<double> dN,
+              double zero)
 {
   const int tdim = facet_tdim(s.type);
   SubFacet f;
@@ -68,27 +94,24 @@ make_subfacet(const FacetSurface& s,
       f.reference_centre[k] += X[k] / reference.size();
   }
   const auto& P = f.polygon;
-  // Degenerate pieces are judged relative to their extent: collinear points
-  // give a cross product of roundoff size, not exactly zero.
-  double extent = 0;
-  for (const Point3& p : P)
-    extent = std::max(extent, norm(sub(p, P[0])));
-  constexpr double degenerate = 1e-12;
+  // !(a > b) rather than a <= b: NaN is degenerate too
   if (s.gdim == 2)
   {
     const Point3 t = sub(P[1], P[0]);
     f.size = norm(t);
-    if (!(f.size > 0) or f.size <= 1e-14 * norm(P[0]))
+    if (!(f.size > zero))
       return std::nullopt;
     f.e1 = { t[0] / f.size, t[1] / f.size, 0 };
     f.normal = { f.e1[1], -f.e1[0], 0 };
     f.e2 = { 0, 0, 0 };
     return f;
   }
+  // |n| is twice the area of a triangle, and of a quadrilateral's projection
+  // on the plane normal to n (the cross product of its diagonals)
   Point3 n = P.size() == 3 ? cross(sub(P[1], P[0]), sub(P[2], P[0]))
                            : cross(sub(P[2], P[0]), sub(P[3], P[1]));
   const double n_norm = norm(n);
-  if (!(n_norm > degenerate * extent * extent))
+  if (!(n_norm > zero * longest_edge(P)))
     return std::nullopt;
   for (double& v : n)
     v /= n_norm;
@@ -98,21 +121,37 @@ make_subfacet(const FacetSurface& s,
   for (int k = 0; k < 3; ++k)
     e1[k] -= along * n[k];
   const double e1_norm = norm(e1);
-  if (!(e1_norm > 0))
+  if (!(e1_norm > zero)) // a quadrilateral with a collapsed first edge
     return std::nullopt;
   for (double& v : e1)
     v /= e1_norm;
   f.e1 = e1;
   f.e2 = cross(n, e1);
-  // area of the polygon projected on its own plane
+  // area of the polygon projected on its own plane: |n|/2 up to round-off,
+  // so positive after the height test
   std::vector<Point2> flat;
   for (const Point3& p : P)
     flat.push_back(
       { dot(sub(p, f.centre), f.e1), dot(sub(p, f.centre), f.e2) });
   f.size = std::abs(signed_area(flat));
-  if (!(f.size > 0))
-    return std::nullopt;
   return f;
+}
+
+/// Cells of @p s with a degenerate piece (make_subfacet), in order.
+std::vector<std::int32_t>
+degenerate_cells(const FacetSurface& s, double zero)
+{
+  const int nn = facet_num_nodes(s.type), tdim = facet_tdim(s.type);
+  std::vector<double> N(nn), dN(tdim * nn);
+  std::vector<std::int32_t> out;
+  for (std::size_t c = 0; c < s.num_cells(); ++c)
+    for (const auto& piece : facet_subfacets(s.type))
+      if (!make_subfacet(s, c, piece, N, dN, zero))
+      {
+        out.push_back(static_cast<std::int32_t>(c));
+        break;
+      }
+  return out;
 }
 
 /// Accumulates the integrals of one slave–master cell pair.
@@ -181,7 +220,29 @@ mortar_integrals(const FacetSurface& slave,
   const auto& master_pieces = facet_subfacets(master.type);
   const std::size_t nq = weights.size();
 
+  // One zero length for every decision of this call: from the caller (the
+  // same on every rank) or from both surfaces' coordinates.
+  double zero;
+  if (options.length_scale > 0)
+    zero = std::max(geometric_tolerance * options.length_scale,
+                    std::numeric_limits<double>::min());
+  else
+  {
+    std::vector<double> both(slave.x.begin(), slave.x.end());
+    both.insert(both.end(), master.x.begin(), master.x.end());
+    zero = zero_length(both, gdim);
+  }
+
   MortarIntegrals out;
+  out.degenerate_slave_facets = degenerate_cells(slave, zero);
+  out.degenerate_master_facets = degenerate_cells(master, zero);
+  // a degenerate cell covers nothing and is covered by nothing
+  std::vector<char> skip_slave(slave.num_cells(), 0),
+    skip_master(master.num_cells(), 0);
+  for (std::int32_t c : out.degenerate_slave_facets)
+    skip_slave[c] = 1;
+  for (std::int32_t c : out.degenerate_master_facets)
+    skip_master[c] = 1;
   PairAccumulator acc(ns, nm);
   std::vector<double> Ns(ns), dNs(tdim * ns), Nm(nm), dNm(tdim * nm);
   std::array<Point3, 2> tangents;
@@ -193,20 +254,19 @@ mortar_integrals(const FacetSurface& slave,
     const auto cm = static_cast<std::size_t>(candidates[2 * p + 1]);
     if (cs >= slave.num_cells() or cm >= master.num_cells())
       throw std::invalid_argument("candidate pair refers to a missing cell");
+    if (skip_slave[cs] or skip_master[cm])
+      continue;
     acc.reset();
     master_subfacets.clear();
     for (const auto& piece : master_pieces)
-      if (auto f = make_subfacet(master, cm, piece, Nm, dNm))
+      if (auto f = make_subfacet(master, cm, piece, Nm, dNm, zero))
         master_subfacets.push_back(std::move(*f));
 
     for (const auto& piece : slave_pieces)
     {
-      const auto sf = make_subfacet(slave, cs, piece, Ns, dNs);
+      const auto sf = make_subfacet(slave, cs, piece, Ns, dNs, zero);
       if (!sf)
-        continue; // a degenerate slave piece covers nothing
-      const double tol_length = options.relative_tolerance *
-                                (gdim == 2 ? sf->size : std::sqrt(sf->size));
-      const double tol_size = options.relative_tolerance * sf->size;
+        continue; // not reached: degenerate cells are skipped above
       auto plane_coords = [&](const Point3& x) -> Point2
       {
         const Point3 r = sub(x, sf->centre);
@@ -218,6 +278,8 @@ mortar_integrals(const FacetSurface& slave,
 
       for (const SubFacet& mf : master_subfacets)
       {
+        // unit normals of non-degenerate pieces: a perpendicular master
+        // projects to a segment and covers nothing on either side of 0
         if (options.opposing_normals_only and dot(mf.normal, sf->normal) >= 0)
           continue;
         std::vector<Point2> master_polygon;
@@ -240,7 +302,7 @@ mortar_integrals(const FacetSurface& slave,
           const double hi =
             std::min(slave_polygon[1][0],
                      std::max(master_polygon[0][0], master_polygon[1][0]));
-          if (hi - lo > tol_size)
+          if (hi - lo > zero)
             cells.push_back({ { lo, 0 }, { hi - lo, 0 }, { 0, 0 }, hi - lo });
         }
         else
@@ -248,11 +310,15 @@ mortar_integrals(const FacetSurface& slave,
           // The slave polygon is counter-clockwise about its own normal by
           // construction; the master one is usually clockwise (it faces the
           // slave) and must be turned for clipping.
+          // the master piece is not degenerate: its area has a sign
           if (signed_area(master_polygon) < 0)
             std::reverse(master_polygon.begin(), master_polygon.end());
           const auto clipped =
-            clip_polygon(slave_polygon, master_polygon, tol_length);
-          if (clipped.size() < 3 or signed_area(clipped) <= tol_size)
+            clip_polygon(slave_polygon, master_polygon, zero);
+          // an overlap no wider than the zero length is a segment or a
+          // point (touching edges, a shared vertex)
+          if (clipped.size() < 3 or
+              !(2 * signed_area(clipped) > zero * longest_edge(clipped)))
             continue;
           Point2 g = { 0, 0 };
           for (const Point2& q : clipped)
@@ -264,6 +330,11 @@ mortar_integrals(const FacetSurface& slave,
             const Point2 a = { q0[0] - g[0], q0[1] - g[1] };
             const Point2 b = { q1[0] - g[0], q1[1] - g[1] };
             const double twice_area = a[0] * b[1] - a[1] * b[0];
+            // Exact sign test: the polygon is convex, wider than the zero
+            // length, and fanned from its centroid, so its fan triangles
+            // are positive up to round-off; a round-off one carries a
+            // round-off weight whichever way it is decided, while a
+            // length-based threshold would drop the fan of a thin overlap.
             if (twice_area > 0)
               cells.push_back({ g, a, b, twice_area });
           }
@@ -301,9 +372,12 @@ mortar_integrals(const FacetSurface& slave,
               for (int k = 0; k < gdim; ++k)
                 n[k] += Ns[a] * na[k];
             }
+            // n interpolates unit vectors: its length is dimensionless and
+            // of order 1 unless the nodal normals cancel
             const double n_norm = norm(n);
+            const bool n_defined = n_norm > geometric_tolerance;
             const Point3 gap_vector = sub(xs, xm);
-            const double d = n_norm > 0 ? dot(gap_vector, n) / n_norm : 0.0;
+            const double d = n_defined ? dot(gap_vector, n) / n_norm : 0.0;
             acc.add(weights[q] * cell.measure, Ns, Nm, d);
             if (options.keep_points)
             {
@@ -313,7 +387,7 @@ mortar_integrals(const FacetSurface& slave,
               out.point_weights.push_back(weights[q] * cell.measure);
               out.point_gap.push_back(d);
               for (int k = 0; k < gdim; ++k)
-                out.point_normals.push_back(n_norm > 0 ? n[k] / n_norm : 0.0);
+                out.point_normals.push_back(n_defined ? n[k] / n_norm : 0.0);
               out.point_slave_N.insert(
                 out.point_slave_N.end(), Ns.begin(), Ns.end());
               out.point_master_N.insert(
@@ -322,6 +396,8 @@ mortar_integrals(const FacetSurface& slave,
           }
       }
     }
+    // acc.area sums positive weights × positive measures: it is exactly 0
+    // when no point was integrated, and only then
     if (acc.area <= 0 and options.keep_points)
     {
       // drop the points of a pair that is not kept

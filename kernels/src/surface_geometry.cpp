@@ -1,10 +1,12 @@
 // Copyright (C) 2026 dolfinx_mortar developers
 // SPDX-License-Identifier: MIT
+#include <dolfinx_mortar/geometric_tolerance.h>
 #include <dolfinx_mortar/surface_geometry.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +28,19 @@ FacetSurface::check() const
   for (std::int32_t v : cells)
     if (v < 0 or v >= num_nodes)
       throw std::invalid_argument("cell node index out of range");
+  // NaN fails every comparison: left in, it would make facets silently
+  // non-degenerate, non-overlapping or unprojectable
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (!std::isfinite(x[i]))
+    {
+      const std::size_t node = i / gdim;
+      std::string coords;
+      for (int k = 0; k < gdim; ++k)
+        coords += (k ? ", " : "") + std::to_string(x[node * gdim + k]);
+      throw std::invalid_argument("node " + std::to_string(node) +
+                                  " has a non-finite coordinate (" + coords +
+                                  ")");
+    }
 }
 
 void
@@ -65,13 +80,21 @@ size_weighted_normal(int gdim, const std::array<Point3, 2>& t)
 }
 
 Point3
-normal_from_tangents(int gdim, const std::array<Point3, 2>& t)
+normal_from_tangents(int gdim, const std::array<Point3, 2>& t, double zero)
 {
   Point3 n = size_weighted_normal(gdim, t);
   const double norm = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-  if (norm > 0)
-    for (double& v : n)
-      v /= norm;
+  // 3D: |n| over the longer tangent is the height of the tangent
+  // parallelogram; 2D: |n| is the tangent's length
+  const double longest =
+    gdim == 2 ? 1.0
+              : std::sqrt(std::max(
+                  t[0][0] * t[0][0] + t[0][1] * t[0][1] + t[0][2] * t[0][2],
+                  t[1][0] * t[1][0] + t[1][1] * t[1][1] + t[1][2] * t[1][2]));
+  if (!(norm > zero * longest))
+    return { 0, 0, 0 };
+  for (double& v : n)
+    v /= norm;
   return n;
 }
 
@@ -107,6 +130,7 @@ element_node_normals(const FacetSurface& s, bool size_weighted)
   const int nn = facet_num_nodes(s.type), tdim = facet_tdim(s.type);
   const std::vector<double> nodes = facet_reference_nodes(s.type);
   std::vector<double> N(nn), dN(tdim * nn), out(s.num_cells() * nn * s.gdim);
+  const double zero = zero_length(s.x, s.gdim);
   Point3 x;
   std::array<Point3, 2> t;
   for (std::size_t c = 0; c < s.num_cells(); ++c)
@@ -115,7 +139,7 @@ element_node_normals(const FacetSurface& s, bool size_weighted)
       facet_geometry(
         s, c, std::span(nodes.data() + i * tdim, tdim), N, dN, x, t);
       const Point3 n = size_weighted ? size_weighted_normal(s.gdim, t)
-                                     : normal_from_tangents(s.gdim, t);
+                                     : normal_from_tangents(s.gdim, t, zero);
       std::copy_n(n.begin(), s.gdim, out.begin() + (c * nn + i) * s.gdim);
     }
   return out;
@@ -162,6 +186,7 @@ project_along(const FacetSurface& s,
   std::array<Point3, 2> t;
   // Residuals are judged against the cell's size and position: roundoff in
   // x(X) grows with |x|, so an absolute tolerance fails far from the origin.
+  // The same scale judges a singular Jacobian and a step at round-off.
   double size = 0, position = 0;
   {
     const std::int32_t* nodes = s.cells.data() + c * nn;
@@ -174,10 +199,13 @@ project_along(const FacetSurface& s,
         position = std::max(position, std::abs(v));
       }
   }
-  const double residual_tolerance =
-    1e-14 *
-    std::max(
-      { size, position, std::abs(p[0]), std::abs(p[1]), std::abs(p[2]) });
+  const double scale = std::max(
+    { size, position, std::abs(p[0]), std::abs(p[1]), std::abs(p[2]) });
+  // Newton's residual target: a few round-offs of x(X), far below the zero
+  // length (the projected point must be accurate, not just "not apart")
+  const double residual_tolerance = 1e-14 * scale;
+  const double zero =
+    std::max(geometric_tolerance * scale, std::numeric_limits<double>::min());
   for (int it = 0; it < 30; ++it)
   {
     facet_geometry(s,
@@ -203,31 +231,47 @@ project_along(const FacetSurface& s,
       out.converged = true;
       return out;
     }
+    // The columns are the tangents (lengths) and the direction: the
+    // determinant over the longest tangent projected along the direction is
+    // the height of the tangents' projected parallelogram (2D: the projected
+    // tangent's length). At most the zero length: the facet is degenerate or
+    // seen edge-on, and has no projection.
+    const Eigen::Vector3d d(direction[0], direction[1], direction[2]);
+    const double dd = d.squaredNorm();
+    double longest = 0;
+    for (int j = 0; j < tdim; ++j)
+    {
+      const Eigen::Vector3d tj = J.col(j);
+      longest = std::max(longest, (tj - (tj.dot(d) / dd) * d).norm());
+    }
     Eigen::Vector3d delta = Eigen::Vector3d::Zero();
     if (n == 2)
     {
       Eigen::Matrix2d J2 = J.topLeftCorner<2, 2>();
       const double det = J2.determinant();
-      if (det == 0.0 or !std::isfinite(det))
+      if (!(std::abs(det) > zero * std::sqrt(dd))) // NaN too
         return out;
       delta.head<2>() = J2.inverse() * F.head<2>();
     }
     else
     {
       const double det = J.determinant();
-      if (det == 0.0 or !std::isfinite(det))
+      if (!(std::abs(det) > zero * longest * std::sqrt(dd)))
         return out;
       delta = J.inverse() * F;
     }
     for (int j = 0; j < tdim; ++j)
       out.X[j] -= delta[j];
     out.t -= delta[tdim];
-    double step = 0;
+    // The step's physical length: reference steps times the tangents, plus
+    // the move along the unit direction.
+    double step = std::abs(delta[tdim]);
     for (int j = 0; j < tdim; ++j)
-      step = std::max(step, std::abs(delta[j]));
-    // A step at roundoff level ends the iteration: the residual cannot fall
-    // further.
-    if (step < 1e-13)
+      step = std::max(step, std::abs(delta[j]) * J.col(j).head(n).norm());
+    // A step below the zero length ends the iteration: Newton converges
+    // quadratically, so what remains is far below it, and the residual may
+    // not reach its target at round-off level.
+    if (step <= zero)
     {
       out.converged = true;
       return out;

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <random>
 #include <vector>
 
 using namespace dolfinx_mortar;
@@ -35,6 +37,56 @@ TEST(Clipping, TriangleInsideSquare)
   std::vector<Point2> t = { { 0, 0 }, { 1, 0 }, { 0, 1 } };
   EXPECT_NEAR(signed_area(clip_polygon(t, sq, 1e-14)), 0.5, 1e-15);
   EXPECT_NEAR(signed_area(clip_polygon(sq, t, 1e-14)), 0.5, 1e-15);
+}
+
+TEST(Clipping, NearCoincidentTrianglesConserveArea)
+{
+  // Two triangles equal up to vertex moves of 1e-16 … 1e-9 (round-off apart,
+  // as separately meshed conforming faces): the overlap is the triangle up to
+  // the tolerance times its perimeter. A crossing point computed for a point
+  // inside only by the tolerance was extrapolated off its edge: areas up to
+  // several times the triangle's.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(-1, 1), exponent(-16, -9);
+  const double tolerance = 1e-10;
+  double worst = 0;
+  for (int trial = 0; trial < 20000; ++trial)
+  {
+    std::vector<Point2> a = { { unit(rng), unit(rng) },
+                              { unit(rng), unit(rng) },
+                              { unit(rng), unit(rng) } };
+    if (signed_area(a) < 0)
+      std::reverse(a.begin(), a.end());
+    if (signed_area(a) < 1e-3)
+      continue;
+    const double move = std::pow(10.0, exponent(rng));
+    std::vector<Point2> b = a;
+    for (Point2& p : b)
+      p = { p[0] + move * unit(rng), p[1] + move * unit(rng) };
+    double perimeter = 0;
+    for (std::size_t i = 0; i < 3; ++i)
+      perimeter +=
+        std::hypot(a[(i + 1) % 3][0] - a[i][0], a[(i + 1) % 3][1] - a[i][1]);
+    const double error =
+      std::abs(signed_area(clip_polygon(a, b, tolerance)) - signed_area(a));
+    worst = std::max(worst, error / ((tolerance + move) * perimeter));
+  }
+  EXPECT_LE(worst, 2.0);
+}
+
+TEST(Clipping, CrossingPointsStayOnTheirEdge)
+{
+  // p is inside by the tolerance only (0.9·tol outside), q just beyond it:
+  // the crossing of p–q with the clip line, computed without the tolerance,
+  // lay 4.5 edge lengths before p.
+  const double tol = 1e-10;
+  std::vector<Point2> clip = { { -2, 0 }, { 10, 0 }, { 10, 10 }, { -2, 10 } };
+  std::vector<Point2> subject = { { 0, -0.9 * tol },
+                                  { 1, -1.1 * tol },
+                                  { 0.5, 1 } };
+  for (const Point2& p : clip_polygon(subject, clip, tol))
+    EXPECT_GE(p[0], -1e-9) << "crossing point off its edge";
+  EXPECT_NEAR(signed_area(clip_polygon(subject, clip, tol)), 0.5, 1e-9);
 }
 
 TEST(BoundingBoxTree, MatchesBruteForce)

@@ -23,6 +23,10 @@ struct MortarIntegrals
   std::vector<double> gap;             ///< (pairs, ns): ∫ N_A d
   std::vector<double> area;            ///< (pairs): covered area
   std::int64_t failed_projections = 0; ///< Newton failures (points skipped)
+  /// Cells whose height (area over longest edge; length in 2D) is below the
+  /// zero length: they cover nothing, and the caller must be told.
+  std::vector<std::int32_t> degenerate_slave_facets;
+  std::vector<std::int32_t> degenerate_master_facets; ///< as the slave's
 
   /// Per quadrature point, only with SegmentationOptions::keep_points (the
   /// pointwise active set needs ⟨d⟩ at every point, not only ∫N d).
@@ -39,8 +43,12 @@ struct SegmentationOptions
 {
   /// Skip master facets whose normal does not oppose the slave's.
   bool opposing_normals_only = true;
-  /// Overlaps smaller than this fraction of the slave sub-facet are dropped.
-  double relative_tolerance = 1e-12;
+  /// The length scale of every geometric decision (degenerate facet, overlap
+  /// of zero area, point on an edge): lengths below geometric_tolerance
+  /// times it are zero. 0: the length_scale() of both surfaces' coordinates.
+  /// Pass one value on every rank so that decisions do not depend on the
+  /// partition.
+  double length_scale = 0;
   /// Also return the data of every quadrature point (MortarIntegrals::point_*).
   bool keep_points = false;
 };
@@ -62,7 +70,11 @@ struct SegmentationOptions
 /// (2D) or triangle (3D), row-major (points, gdim − 1)
 /// @param[in] weights Quadrature weights (sum 1 or ½)
 /// @param[in] options Segmentation options
-/// @return Integrals of the pairs that overlap
+/// @return Integrals of the pairs that overlap, and the degenerate cells of
+/// both surfaces (all of them, candidates or not); pairs with a degenerate
+/// cell are skipped
+/// @throws std::invalid_argument for inconsistent arrays or a NaN or
+/// infinite coordinate
 MortarIntegrals
 mortar_integrals(const FacetSurface& slave,
                  std::span<const double> slave_normals,

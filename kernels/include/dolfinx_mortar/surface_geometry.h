@@ -22,7 +22,8 @@ struct FacetSurface
   std::span<const std::int32_t> cells; ///< (cells, nodes per cell)
 
   std::size_t num_cells() const { return cells.size() / facet_num_nodes(type); }
-  /// Throws std::invalid_argument if the arrays do not fit together.
+  /// Throws std::invalid_argument if the arrays do not fit together or a
+  /// coordinate is NaN or infinite (naming the node).
   void check() const;
 };
 
@@ -43,9 +44,13 @@ facet_geometry(const FacetSurface& s,
 Point3
 size_weighted_normal(int gdim, const std::array<Point3, 2>& tangents);
 
-/// Unit normal from tangents (2D: only tangents[0] is used).
+/// Unit normal from tangents (2D: only tangents[0] is used), or the zero
+/// vector where the tangents span no plane: the tangent's length (2D) or the
+/// tangents' parallelogram height (3D) at most @p zero (zero_length()).
 Point3
-normal_from_tangents(int gdim, const std::array<Point3, 2>& tangents);
+normal_from_tangents(int gdim,
+                     const std::array<Point3, 2>& tangents,
+                     double zero);
 
 /// Reference coordinates of the nodes, row-major (nodes, tdim).
 std::vector<double>
