@@ -26,6 +26,7 @@ from dolfinx_mortar import _kernels
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.layout import MassMatrixSolver
 from dolfinx_mortar.tabulation import Tabulation
+from dolfinx_mortar.tolerance import length_scale
 
 FloatArray = npt.NDArray[np.float64]
 FieldLike = Union[Callable[[FloatArray], FloatArray], FloatArray]
@@ -71,7 +72,11 @@ class MortarBasis:
         #: W_A = ∫ N_A dA at owned and ghost functions
         self.lumped_weights = self.layout.sum_at_functions(self.cells, self.element_weights)
         nodal_at_cells = self.lumped_weights[self.cells]
+        gdim = tab.points.shape[2]
+        scale = length_scale(tab.points.reshape(-1, gdim), self.layout.comm)
         try:
+            _kernels.check_element_measures(self.element_weights, tab.points, surface.tdim,
+                                            scale)
             _kernels.check_lumped_weights(self.kind, self.element_weights, nodal_at_cells)
             if is_global(self.kind):
                 self.coefficients = None

@@ -235,3 +235,39 @@ def test_current_mortar_3d_patch_test():
                             "--basis-configuration", "current"])
     r = demo.run(args, "finer-slave", "LcLS*", "consistent")
     assert r["max_relative_deviation"] < 2e-5, r   # 3.9e-6 measured: the 1/ε effect
+
+
+def test_jet_clipping_conserves_the_area_of_near_coincident_triangles():
+    """The Jet copy of clip_polygon makes the kernel's decisions: two triangles
+    equal up to vertex moves of 1e-16 … 1e-9 overlap in the triangle, up to the
+    tolerance times the perimeter (crossings extrapolated off their edges gave
+    up to several times its area before)."""
+    from dolfinx_mortar.current_mortar_3d import _signed_area, clip_polygon
+    from dolfinx_mortar.jet import Jet
+    rng = np.random.default_rng(3)
+    tolerance, worst = 1e-10, 0.0
+    for _ in range(300):
+        a = rng.uniform(-1, 1, (3, 2))
+        if np.cross(a[1] - a[0], a[2] - a[0]) < 0:
+            a = a[::-1]
+        if abs(np.cross(a[1] - a[0], a[2] - a[0])) < 2e-3:
+            continue
+        move = 10.0 ** rng.uniform(-16, -9)
+        b = a + move * rng.uniform(-1, 1, a.shape)
+        v = Jet.variables(np.concatenate([a, b]).reshape(1, -1))
+        points = [[v[2 * i], v[2 * i + 1]] for i in range(6)]
+        clipped = clip_polygon(points[:3], points[3:], tolerance)
+        area = float(_signed_area(clipped).value[0]) if len(clipped) >= 3 else 0.0
+        exact = 0.5 * abs(np.cross(a[1] - a[0], a[2] - a[0]))
+        perimeter = np.sum(np.linalg.norm(a - np.roll(a, 1, axis=0), axis=1))
+        worst = max(worst, abs(area - exact) / ((tolerance + move) * perimeter))
+    assert worst <= 2.0, worst
+    # p inside by the tolerance only (0.9·tol outside), q just beyond it: the
+    # crossing computed without the tolerance lay 4.5 edge lengths before p
+    v = Jet.variables(np.array([[0.0, -0.9 * tolerance, 1.0, -1.1 * tolerance, 0.5, 1.0,
+                                 -2.0, 0.0, 10.0, 0.0, 10.0, 10.0, -2.0, 10.0]]))
+    points = [[v[2 * i], v[2 * i + 1]] for i in range(7)]
+    subject, box = points[:3], points[3:]
+    clipped = clip_polygon(subject, box, tolerance)
+    assert min(float(p[0].value[0]) for p in clipped) >= -1e-9
+    assert abs(float(_signed_area(clipped).value[0]) - 0.5) <= 1e-9

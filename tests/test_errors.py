@@ -6,9 +6,10 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar import MortarBasis, basis, nurbs
+from dolfinx_mortar import MortarBasis, _kernels, basis, nurbs
 from dolfinx_mortar.facet_surface import facet_surface
 from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.mortar import MortarCoupling
 
 from surfaces import curved_patch
 
@@ -67,6 +68,71 @@ def test_sliver_triangle_is_not_degenerate_and_its_area_is_exact():
     surface = LagrangeSurface("triangle", 1, x, [[0, 1, 2]])
     area = surface.tabulate().weights.sum()
     assert area == pytest.approx(0.5e-8, rel=1e-12)
+
+
+_TILT = np.linalg.qr(np.array([[1.0, 0.3, -0.2], [0.1, 1.0, 0.4], [0.3, -0.5, 1.0]]))[0]
+if np.linalg.det(_TILT) < 0:
+    _TILT[:, 0] *= -1
+
+
+def _degenerate_surface(case: str, offset: float) -> LagrangeSurface:
+    """Cell 1 is degenerate: a zero-length P1 line, or a collinear P1 triangle
+    (its third node on the opposite edge)."""
+    if case == "zero-length-line":
+        x = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+        return LagrangeSurface("interval", 1, x + offset, [[0, 1], [1, 2], [2, 3]])
+    x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0],
+                  [0.5, 0.5, 0.0]])
+    # tilted, so that the collinear cell's area is round-off, not exactly 0
+    return LagrangeSurface("triangle", 1, x @ _TILT.T + offset,
+                           [[0, 1, 2], [0, 4, 3], [1, 3, 2]])
+
+
+def _regular_surface(case: str, offset: float) -> LagrangeSurface:
+    """A regular surface just below the degenerate one, facing it."""
+    if case == "zero-length-line":
+        x = np.array([[0.0, -0.01], [1.0, -0.01], [2.0, -0.01]])
+        return LagrangeSurface("interval", 1, x + offset, [[1, 0], [2, 1]])
+    x = np.array([[0.0, 0.0, -0.01], [1.0, 0.0, -0.01], [0.0, 1.0, -0.01], [1.0, 1.0, -0.01]])
+    return LagrangeSurface("triangle", 1, x @ _TILT.T + offset, [[0, 2, 1], [1, 2, 3]])
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e4])
+@pytest.mark.parametrize("case", ["zero-length-line", "collinear-triangle"])
+def test_degenerate_facets_are_reported_whatever_the_round_off(case, offset):
+    """A degenerate cell measures 0, 5.5e-17 or 1.1e-16 at |x| = 1 depending
+    on the BLAS kernels (OPENBLAS_CORETYPE), 1.8e-12 at |x| = 1e4: it is judged
+    against the zero length of the geometry, never against 0. Before, the
+    basis took such a cell for a real one, and the segmentation dropped it
+    without a word."""
+    surface = _degenerate_surface(case, offset)
+    for kind in ("LmLS*", "LcLS*"):
+        with pytest.raises(ValueError, match="degenerate slave element: cell 1 "):
+            MortarBasis(kind, surface)
+    with pytest.raises(ValueError, match="degenerate contact facets.*slave facet 1 .*nodes"):
+        MortarCoupling(surface, _regular_surface(case, offset))
+    # a zero-length master facet is a broken mesh too
+    with pytest.raises(ValueError, match="degenerate contact facets.*master facet 1 .*nodes"):
+        MortarCoupling(_regular_surface(case, offset).reflected([True] * 2),
+                       surface.reflected([True] * 3))
+    # regular surfaces at the same place are not degenerate
+    MortarBasis("LcLS*", _regular_surface(case, offset))
+
+
+def test_nan_coordinates_are_rejected_by_the_kernels():
+    x = np.array([[0.0, 0.0], [1.0, 0.0], [np.nan, 0.0]])
+    cells = np.array([[0, 1], [1, 2]], dtype=np.int32)
+    with pytest.raises(ValueError, match=r"node 2 has a non-finite coordinate \(nan, 0"):
+        _kernels.element_node_normals(_kernels.FacetType.P1_line, x, cells)
+    good = np.array([[0.0, 0.1], [1.0, 0.1], [2.0, 0.1]])
+    with pytest.raises(ValueError, match="node 2 has a non-finite coordinate"):
+        _kernels.mortar_integrals(_kernels.FacetType.P1_line, good, cells, np.zeros((3, 2)),
+                                  _kernels.FacetType.P1_line, x, cells,
+                                  np.zeros((0, 2), dtype=np.int32),
+                                  np.array([[0.5]]), np.array([1.0]))
+    x[2] = [np.inf, 0.0]
+    with pytest.raises(ValueError, match="node 2 has a non-finite coordinate"):
+        _kernels.facet_bounding_boxes(_kernels.FacetType.P1_line, x, cells, 0.0)
 
 
 def test_nan_field_is_reported():

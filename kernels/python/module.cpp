@@ -149,24 +149,46 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("phi"),
     py::arg("weights"));
   m.def(
+    "check_element_measures",
+    [](const array_t& element_weights,
+       const array_t& points,
+       int tdim,
+       double length_scale)
+    {
+      if (element_weights.ndim() != 2 or points.ndim() != 3 or
+          points.shape(0) != element_weights.shape(0))
+        throw std::invalid_argument("element weights must be (cells, "
+                                    "functions), points (cells, points, "
+                                    "gdim)");
+      check_element_measures(as_span(element_weights),
+                             element_weights.shape(1),
+                             as_span(points),
+                             static_cast<int>(points.shape(2)),
+                             tdim,
+                             length_scale);
+    },
+    py::arg("element_weights"),
+    py::arg("points"),
+    py::arg("tdim"),
+    py::arg("length_scale"),
+    "Raise naming the first element whose measure is at most the zero "
+    "measure of the geometry");
+  m.def(
     "check_lumped_weights",
     [](BasisKind kind,
        const array_t& element_weights,
-       const array_t& nodal_weights,
-       double tol)
+       const array_t& nodal_weights)
     {
       if (element_weights.ndim() != 2)
         throw std::invalid_argument("element weights must be 2D");
       check_lumped_weights(kind,
                            as_span(element_weights),
                            as_span(nodal_weights),
-                           element_weights.shape(1),
-                           tol);
+                           element_weights.shape(1));
     },
     py::arg("kind"),
     py::arg("element_weights"),
-    py::arg("nodal_weights"),
-    py::arg("relative_tolerance") = 1e-12);
+    py::arg("nodal_weights"));
   m.def(
     "basis_coefficients",
     [](BasisKind kind,

@@ -1,10 +1,13 @@
 // Copyright (C) 2026 dolfinx_mortar developers
 // SPDX-License-Identifier: MIT
 #include <dolfinx_mortar/basis_coefficients.h>
+#include <dolfinx_mortar/geometric_tolerance.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -42,11 +45,62 @@ throw_weight_error(BasisKind kind,
 } // namespace
 
 void
+check_element_measures(std::span<const double> element_weights,
+                       std::size_t num_functions,
+                       std::span<const double> points,
+                       int gdim,
+                       int tdim,
+                       double length_scale)
+{
+  if (num_functions == 0 or element_weights.size() % num_functions != 0)
+    throw std::invalid_argument(
+      "element weights must have shape (cells, functions)");
+  const std::size_t nc = element_weights.size() / num_functions;
+  if (nc == 0)
+    return; // a rank may hold no element
+  if (gdim < 1 or gdim > 3 or tdim < 1 or tdim > 2 or
+      points.size() % (nc * gdim) != 0)
+    throw std::invalid_argument(
+      "quadrature points must have shape (cells, points, gdim)");
+  const std::size_t per_cell = points.size() / nc;
+  const double zero = std::max(geometric_tolerance * length_scale,
+                               std::numeric_limits<double>::min());
+  for (std::size_t c = 0; c < nc; ++c)
+  {
+    const double measure = element_measure(
+      element_weights.subspan(c * num_functions, num_functions));
+    // the extent of the element's points: its size, whatever its position
+    const auto x = points.subspan(c * per_cell, per_cell);
+    double extent = 0;
+    for (int k = 0; k < gdim; ++k)
+    {
+      double lo = x[k], hi = x[k];
+      for (std::size_t i = k; i < x.size(); i += gdim)
+      {
+        lo = std::min(lo, x[i]);
+        hi = std::max(hi, x[i]);
+      }
+      extent += (hi - lo) * (hi - lo);
+    }
+    const double zero_measure = tdim == 1 ? zero : zero * std::sqrt(extent);
+    if (!(measure > zero_measure) or !std::isfinite(measure))
+    {
+      std::ostringstream msg;
+      msg << "degenerate slave element: cell " << c << " has measure "
+          << measure << ", at most the zero "
+          << (tdim == 1 ? "length " : "measure ") << zero_measure
+          << " (tolerance " << geometric_tolerance << " × length scale "
+          << length_scale << ")";
+      throw std::domain_error(msg.str());
+    }
+  }
+}
+
+void
 check_lumped_weights(BasisKind kind,
                      std::span<const double> element_weights,
                      std::span<const double> nodal_weights,
-                     std::size_t num_functions,
-                     double relative_tolerance)
+                     std::size_t num_functions)
 {
   if (num_functions == 0 or element_weights.size() % num_functions != 0 or
       nodal_weights.size() != element_weights.size())
@@ -62,6 +116,9 @@ check_lumped_weights(BasisKind kind,
     auto we = element_weights.subspan(c * num_functions, num_functions);
     auto wn = nodal_weights.subspan(c * num_functions, num_functions);
     const double measure = element_measure(we);
+    // Degeneracy against the geometry is check_element_measures' decision;
+    // this only keeps a non-positive or NaN measure (a covered part of
+    // nothing) out of the ratios below.
     if (!(measure > 0.0) or !std::isfinite(measure))
     {
       std::ostringstream msg;
@@ -71,9 +128,9 @@ check_lumped_weights(BasisKind kind,
     }
     for (std::size_t i = 0; i < num_functions; ++i)
     {
-      if (element_check and !(we[i] > relative_tolerance * measure))
+      if (element_check and !(we[i] > geometric_tolerance * measure))
         throw_weight_error(kind, c, i, we[i], measure, false);
-      if (nodal_check and !(wn[i] > relative_tolerance * measure))
+      if (nodal_check and !(wn[i] > geometric_tolerance * measure))
         throw_weight_error(kind, c, i, wn[i], measure, true);
     }
   }

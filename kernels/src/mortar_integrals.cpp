@@ -309,8 +309,8 @@ mortar_integrals(const FacetSurface& slave,
         {
           // The slave polygon is counter-clockwise about its own normal by
           // construction; the master one is usually clockwise (it faces the
-          // slave) and must be turned for clipping.
-          // the master piece is not degenerate: its area has a sign
+          // slave) and must be turned for clipping. It is not degenerate, so
+          // the sign of its area is not round-off.
           if (signed_area(master_polygon) < 0)
             std::reverse(master_polygon.begin(), master_polygon.end());
           const auto clipped =
