@@ -3,7 +3,8 @@
 Small-strain linear elasticity (plane strain in 2D) through UFL, penalty mortar
 contact against a rigid analytic obstacle or an elastic master in the same
 mesh, Newton through PETSc SNES (options prefix ``dolfinx_mortar_``), load steps
-that are cut back when Newton fails, and XDMF output after every converged step.
+that are cut back when Newton fails, and crash-safe XDMF output after every
+converged step.
 """
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from typing import Callable, Optional, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 import ufl
-from dolfinx import fem, io
+from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -32,6 +33,7 @@ from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.obstacles import RigidObstacle
 from dolfinx_mortar.pointwise import obstacle_positive_gaps
 from dolfinx_mortar.surface_output import SlaveSurfaceOutput, surface_output_path
+from dolfinx_mortar.xdmf_series import XdmfSeries
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -301,7 +303,7 @@ class ContactProblem:
         self.b = fem_petsc.create_vector(self.F_form)
         self.A_bulk = fem_petsc.create_matrix(self.J_form)
         self.timings: dict[str, float] = {}
-        self._output: Optional[Path] = None
+        self._output: Optional[XdmfSeries] = None
         self._warn_deep_initial_penetration()
 
     def _warn_deep_initial_penetration(self) -> None:
@@ -805,21 +807,14 @@ class ContactProblem:
         return float(self.mesh.comm.allreduce(float(np.sum((W * p)[:n]))))
 
     def _open_output(self, path: Path) -> None:
-        if path.suffix != ".xdmf":
-            raise ValueError(f"output must be an .xdmf file, got {path}")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self._output = path
-        with io.XDMFFile(self.mesh.comm, str(path), "w") as f:
-            f.write_mesh(self.mesh)
+        self._output = XdmfSeries(path, self.mesh)
         self._surface_output = SlaveSurfaceOutput(self.slave, surface_output_path(path))
 
     def _write_step(self, t: float, state: ContactState) -> None:
-        """Append the step, reopening the file so that it is complete on disk."""
+        """Add the step to both files; each is complete on disk after it
+        (:mod:`dolfinx_mortar.xdmf_series`)."""
         pressures = self.nodal_pressures(state)
-        u1, p_hat = self._output_functions(pressures)
-        with io.XDMFFile(self.mesh.comm, str(self._output), "a") as f:
-            f.write_function(u1, t)
-            f.write_function(p_hat, t)
+        self._output.write(self._output_functions(pressures), t)
         self._surface_output.write({"p_hat": pressures[self.slave.cells],
                                     "p_star": self.mortar_traction(state)}, t)
 

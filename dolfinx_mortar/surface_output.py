@@ -14,10 +14,11 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 import ufl
-from dolfinx import cpp, fem, io
+from dolfinx import cpp, fem
 from dolfinx import mesh as dmesh
 
 from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.xdmf_series import XdmfSeries
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -36,7 +37,8 @@ class SlaveSurfaceOutput:
     slave
         The slave surface (this rank's facets).
     path
-        The ``.xdmf`` file; it is created with the surface mesh.
+        The ``.xdmf`` index; it is created with the surface mesh, its data
+        files next to it (:class:`dolfinx_mortar.xdmf_series.XdmfSeries`).
     """
 
     def __init__(self, slave: LagrangeSurface, path: Path):
@@ -64,9 +66,7 @@ class SlaveSurfaceOutput:
         #: slave cell of every surface-mesh cell, and the dofs of its nodes
         self.source = original - offset
         self.dofs = self.space.dofmap.list.array.reshape(-1, nd)[:num_local]
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        with io.XDMFFile(comm, str(self.path), "w") as f:
-            f.write_mesh(self.mesh)
+        self.series = XdmfSeries(self.path, self.mesh)
 
     def function(self, name: str, values: FloatArray) -> fem.Function:
         """A function from values at every node of every slave cell, (cells, nd)."""
@@ -75,8 +75,6 @@ class SlaveSurfaceOutput:
         return u
 
     def write(self, fields: dict[str, FloatArray], t: float) -> None:
-        """Append fields (name → (cells, nd) values) at time t; the file stays
-        complete on disk after every call."""
-        with io.XDMFFile(self.slave.layout.comm, str(self.path), "a") as f:
-            for name, values in fields.items():
-                f.write_function(self.function(name, values), t)
+        """Add fields (name → (cells, nd) values) at time t; the file is
+        complete on disk after every call (:mod:`dolfinx_mortar.xdmf_series`)."""
+        self.series.write([self.function(name, values) for name, values in fields.items()], t)

@@ -1,0 +1,158 @@
+"""XDMF time series that survive a crash: every indexed step is complete on disk.
+
+DOLFINx 0.5.2's ``io.XDMFFile`` rewrites the ``.xdmf`` index in place
+(pugixml truncates, then writes) right after adding a dataset to the ``.h5``
+and before the ``.h5`` is closed. A run killed during output left a 0-byte
+index (every earlier step lost) or an index naming a dataset not yet in the
+``.h5`` (4 of 20 trials in issue 10). Appending to an ``.h5`` that is killed
+while open can also damage what it already held: HDF5 caches the file's
+metadata and gives no guarantee for a file that was not closed.
+
+So here no file that the index names is ever opened for writing again:
+
+- ``<stem>.h5`` holds the mesh, written once;
+- ``<stem>_steps/<k>.h5`` holds step k, written (by DOLFINx) and closed before
+  the index names it;
+- ``<stem>.xdmf``, the index, is written by rank 0 to a temporary file in the
+  same folder and renamed over the old one (``os.replace``, atomic on POSIX),
+  after a barrier that follows the collective close of the step's ``.h5``.
+
+A kill at any moment leaves the previous or the new index, each naming only
+closed files. DOLFINx's own index of each file is a scratch file
+(``*.xdmf-partial``) merged into the real index and deleted.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Sequence
+from xml.sax.saxutils import quoteattr
+
+from dolfinx import fem, io
+from dolfinx import mesh as dmesh
+
+XINCLUDE = "http://www.w3.org/2001/XInclude"
+#: the mesh is the first uniform grid of the index, as DOLFINx's default
+MESH_POINTER = ("xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]"
+                "/*[self::Topology or self::Geometry])")
+_HEADER = '<?xml version="1.0"?>\n<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>\n'
+ET.register_namespace("xi", XINCLUDE)
+
+
+def steps_folder(path: Path) -> Path:
+    """The folder of the per-step ``.h5`` files of the index ``path``."""
+    return path.with_name(path.stem + "_steps")
+
+
+class XdmfSeries:
+    """Writes a mesh once and functions at every step, crash-safe (module doc).
+
+    Parameters
+    ----------
+    path
+        The ``.xdmf`` index; any earlier series at this path is replaced.
+    mesh
+        The mesh every written function lives on.
+    """
+
+    def __init__(self, path: Path, mesh: dmesh.Mesh):
+        self.path = Path(path)
+        if self.path.suffix != ".xdmf":
+            raise ValueError(f"output must be an .xdmf file, got {self.path}")
+        self.comm = mesh.comm
+        self.steps = steps_folder(self.path)
+        self.count = 0
+        if self.comm.rank == 0:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            # an earlier series here is replaced: its index goes first, so that
+            # no index ever names the files removed or overwritten next
+            self.path.unlink(missing_ok=True)
+            for stale in self.path.parent.glob(f".{self.path.name}.*.tmp"):
+                stale.unlink(missing_ok=True)
+            shutil.rmtree(self.steps, ignore_errors=True)
+            self.steps.mkdir()
+        self.comm.barrier()
+        scratch = self.path.with_suffix(".xdmf-partial")   # its data file: <stem>.h5
+        with io.XDMFFile(self.comm, str(scratch), "w") as f:
+            f.write_mesh(mesh)
+        self.comm.barrier()
+        if self.comm.rank == 0:
+            # the index's text is kept in pieces, one per grid: serializing
+            # the whole tree at every step made 200 steps 3× slower
+            self._mesh = [_text(grid, 2) for grid in ET.parse(scratch).getroot().find("Domain")]
+            self._series: dict[str, tuple[dict, list[str]]] = {}
+            scratch.unlink()
+            self._publish([self.path.with_suffix(".h5")])
+
+    def write(self, functions: Sequence[fem.Function], t: float) -> None:
+        """Add the functions at time t (collective); on return the index names them."""
+        self.count += 1
+        scratch = self.steps / f"{self.count:06d}.xdmf-partial"
+        with io.XDMFFile(self.comm, str(scratch), "w") as f:
+            for u in functions:
+                # any existing node: the mesh reference is rewritten below
+                f.write_function(u, t, mesh_xpath="/Xdmf/Domain")
+        # every rank's part of the .h5 is written and the file closed
+        self.comm.barrier()
+        if self.comm.rank == 0:
+            self._merge(ET.parse(scratch).getroot())
+            scratch.unlink()
+            self._publish([scratch.with_suffix(".h5")])
+
+    def _merge(self, step: ET.Element) -> None:
+        """Move the step's grids into the index, naming its data file from
+        the index's folder and pointing at the index's mesh."""
+        for series in step.find("Domain").findall("Grid"):
+            _, grids = self._series.setdefault(series.get("Name"), (dict(series.attrib), []))
+            for grid in series.findall("Grid"):
+                for include in grid.iter(f"{{{XINCLUDE}}}include"):
+                    include.set("xpointer", MESH_POINTER)
+                for item in grid.iter("DataItem"):
+                    if item.get("Format") == "HDF":
+                        item.text = f"{self.steps.name}/{item.text.strip()}"
+                grids.append(_text(grid, 3))
+
+    def _publish(self, data_files: Sequence[Path]) -> None:
+        """Make the new data durable, then swap in the new index (rank 0)."""
+        for data in data_files:
+            _fsync(data)
+        text = [_HEADER, f'<Xdmf Version="3.0" xmlns:xi="{XINCLUDE}">\n  <Domain>\n',
+                *self._mesh]
+        for attributes, grids in self._series.values():
+            opening = " ".join(f"{k}={quoteattr(v)}" for k, v in attributes.items())
+            text += [f"    <Grid {opening}>\n", *grids, "    </Grid>\n"]
+        text.append("  </Domain>\n</Xdmf>\n")
+        fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=f".{self.path.name}.",
+                                   suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write("".join(text))
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(tmp, self.path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+            raise
+
+
+def _text(element: ET.Element, level: int) -> str:
+    """An element as indented XML text at ``level`` (the xi prefix is declared
+    on the index's root)."""
+    ET.indent(element, space="  ", level=level)
+    element.tail = None
+    text = ET.tostring(element, encoding="unicode").replace(f' xmlns:xi="{XINCLUDE}"', "")
+    return "  " * level + text + "\n"
+
+
+def _fsync(path: Path) -> None:
+    """Flush a closed file's data to the disk (a kill cannot lose it; a power
+    cut then cannot either)."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
