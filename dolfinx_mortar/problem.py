@@ -3,8 +3,8 @@
 Small-strain linear elasticity (plane strain in 2D) through UFL, penalty mortar
 contact against a rigid analytic obstacle or an elastic master in the same
 mesh, Newton through PETSc SNES (options prefix ``dolfinx_mortar_``), load steps
-that are cut back when Newton fails, and crash-safe XDMF output after every
-converged step.
+that are cut back when Newton fails and regrown after successes, and crash-safe
+XDMF output after every converged step.
 """
 from __future__ import annotations
 
@@ -23,11 +23,14 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_kind
+from dolfinx_mortar.convergence import (ContactDivergenceError, EquilibriumTest, FailedAttempt,
+                                        describe_failure)
 from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
 from dolfinx_mortar.current_mortar import CurrentMortarGap
 from dolfinx_mortar.finite_deformation import CurrentObstacleGap, CurrentState, CurrentSurfaceGap
 from dolfinx_mortar.input_checks import check_boundary_data, check_cells, unused_petsc_options
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, parse_kind
+from dolfinx_mortar.load_stepping import LoadStepper
 from dolfinx_mortar.mortar import MortarCoupling
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.obstacles import RigidObstacle
@@ -48,11 +51,13 @@ CONFIGURATIONS = ("initial", "previous", "current")
 DEFAULT_OPTIONS = {
     "snes_type": "newtonls",
     "snes_linesearch_type": "basic",
+    # relative to the out-of-balance force where the step starts
+    # (dolfinx_mortar.convergence.EquilibriumTest)
     "snes_rtol": 1e-11,
     # absolute residuals depend on the units: rely on the relative test
     "snes_atol": 1e-15,
-    # a Newton step at roundoff size ends the iteration: rtol alone can be
-    # unreachable when the first residual is already small
+    # a Newton step at round-off size ends the iteration, as a failure unless
+    # the residual test holds
     "snes_stol": 1e-13,
     "snes_max_it": 40,
     # the first step of a contact problem often overshoots into the obstacle
@@ -85,26 +90,6 @@ class ContactState:
     G_plus: Optional[PETSc.Mat] = None
     #: basis_configuration="current": the full residual and Jacobian data
     current: Optional[CurrentState] = None
-
-
-class ContactDivergenceError(RuntimeError):
-    """Newton failed at a load step even after the step was cut back.
-
-    Attributes
-    ----------
-    load_factor
-        The load factor that could not be reached.
-    history
-        One (load factor, SNES reason, residual norms) entry per failed attempt.
-    """
-
-    def __init__(self, load_factor: float, history: list):
-        self.load_factor = load_factor
-        self.history = history
-        lines = [f"  load {lf:.6g}: SNES reason {reason}, residuals "
-                 + ", ".join(f"{r:.3e}" for r in res) for lf, reason, res in history]
-        super().__init__(f"Newton diverged at load factor {load_factor:.6g} after "
-                         f"{len(history)} attempts:\n" + "\n".join(lines))
 
 
 @dataclass
@@ -563,10 +548,10 @@ class ContactProblem:
         gaps (a tenth of an element), which Newton then takes back. Pulling
         only the closest node instead left rotations about it free (singular
         on a grazing disk). It changes only where Newton starts, not the
-        solution. GLS kinds skip it (their d̄ = L⁻¹ĝ changes sign anyway).
+        solution. For GLS kinds (d̄ = L⁻¹ĝ, G = L⁻¹Ĝ) the pull is
+        ``Ĝᵀ L⁻¹ ω(d̄)`` on the near nodes and the step comes from the augmented
+        system, whose Jacobian (:meth:`_jacobian`) already stiffens them.
         """
-        if isinstance(self.gap_model, GlobalGap):
-            return
         self._residual(None, x, self.b)
         state = self._state
         n = self.slave.layout.num_owned
@@ -580,9 +565,11 @@ class ContactProblem:
         J = self._total_matrix()
         self._jacobian(snes, x, J, J)
         rhs = self.b.copy()
+        force = self.gap_model.weights * near * state.gaps
+        if isinstance(self.gap_model, GlobalGap):
+            force = self.gap_model.mass.solve(force)
         pull = state.G.createVecRight()
-        state.G.multTranspose(self.slave.layout.vector(self.gap_model.weights * near
-                                                       * state.gaps), pull)
+        state.G.multTranspose(self.slave.layout.vector(force), pull)
         rhs.axpy(1.0, pull)
         ksp = snes.getKSP()
         ksp.setOperators(J)
@@ -635,6 +622,8 @@ class ContactProblem:
         snes.setJacobian(self._jacobian, self._total_matrix())
         snes.setConvergenceHistory()
         snes.setFromOptions()
+        self._equilibrium = EquilibriumTest()
+        snes.setConvergenceTest(self._equilibrium)
         if (self.basis_configuration == "current"
                 and not PETSc.Options().hasName(prefix + "snes_linesearch_type")):
             # On the current surface a pressure far above the final one (the first
@@ -657,8 +646,13 @@ class ContactProblem:
         for c, value in self._bc_values:
             c.value = factor * value
 
-    def _newton(self, snes: PETSc.SNES, x: PETSc.Vec) -> tuple[int, list, int]:
-        """One load step's Newton solve from x: SNES reason, residuals, iterations.
+    def _newton(self, snes: PETSc.SNES, x: PETSc.Vec) -> tuple[int, list, int, str]:
+        """One load step's Newton solve from x: SNES reason, residuals, iterations
+        and, if it failed, what stopped it (in words).
+
+        The step is accepted when ``‖R‖ ≤ rtol·F`` (:class:`EquilibriumTest`)
+        with F the residual norm at x before the gap-closing start: the force
+        out of balance when the step starts, whatever Newton starts from.
 
         With basis_configuration="current" the step is first solved with the
         surface frozen where the step starts (the "previous" model: piecewise
@@ -669,6 +663,8 @@ class ContactProblem:
         """
         history: list = []
         iterations = 0
+        self._residual(None, x, self.b)
+        self._equilibrium.start(self.b.norm())
         current = self.gap_model if self.basis_configuration == "current" else None
         phases = [None, current] if current is not None else [None]
         for phase in phases:
@@ -692,8 +688,8 @@ class ContactProblem:
             history += list(snes.getConvergenceHistory()[0])
             iterations += snes.getIterationNumber()
             if reason <= 0:
-                break
-        return reason, history, iterations
+                return reason, history, iterations, describe_failure(snes, self._equilibrium)
+        return reason, history, iterations, ""
 
     def solve(self, load_steps: int = 1, output: Optional[Union[str, Path]] = None,
               max_cuts: int = 5, progress: bool = False,
@@ -702,30 +698,36 @@ class ContactProblem:
               ) -> SolveResult:
         """Apply the load in ``load_steps`` equal steps.
 
-        A step whose Newton solve fails is halved and retried, at most
-        ``max_cuts`` times in a row; then :class:`ContactDivergenceError` is
-        raised with the residual history. Each converged step is written to
-        ``output`` (XDMF: displacement and ``p̂`` on the mesh) and to
-        ``<output stem>_slave.xdmf`` (``p̂`` and ``p*`` on the slave facets, one
-        set of nodes per facet since ``p*`` may jump) before the next one starts.
+        A step whose Newton solve fails (no equilibrium, :class:`EquilibriumTest`)
+        is halved and retried, at most ``max_cuts`` times in a row; then
+        :class:`ContactDivergenceError` is raised with every attempt's cause
+        and residual history. After two successes in a row a cut step is
+        doubled again, up to ``1 / load_steps``; the last step ends exactly at
+        load factor 1 (:class:`dolfinx_mortar.load_stepping.LoadStepper`).
+        Each converged step is written to ``output`` (XDMF: displacement and
+        ``p̂`` on the mesh) and to ``<output stem>_slave.xdmf`` (``p̂`` and
+        ``p*`` on the slave facets, one set of nodes per facet since ``p*``
+        may jump) before the next one starts.
+
+        Parameters
+        ----------
+        load_steps
+            A positive integer (numpy integers too).
         """
-        if load_steps < 1:
-            raise ValueError("load_steps must be at least 1")
+        stepper = LoadStepper(load_steps, max_cuts)
         if not np.all(np.isfinite(self.u.x.array)):
             raise ValueError("the displacement contains NaN or infinite values")
         if output is not None:
             self._open_output(Path(output))
         snes = self._snes(prefix)
         result = SolveResult()
-        reached, step = 0.0, 1.0 / load_steps
-        failures: list = []
+        failures: list[FailedAttempt] = []
         bar = None
         if progress and self.mesh.comm.rank == 0:
             from tqdm import tqdm
-            bar = tqdm(total=load_steps, desc="load steps", unit="step")
-        x = self.u.vector.copy()
-        while reached < 1.0 - 1e-12:
-            target = min(1.0, reached + step)
+            bar = tqdm(total=stepper.load_steps, desc="load steps", unit="step")
+        while not stepper.done:
+            target = stepper.target()
             self._set_load(target)
             if self.basis_configuration == "previous" and self._moved_since_segmentation():
                 # "previous": bases and segmentation of the last converged step,
@@ -737,15 +739,15 @@ class ContactProblem:
             saved = self.u.vector.copy()
             clock = time.perf_counter()
             x = self.u.vector.copy()
-            reason, history, iterations = self._newton(snes, x)
+            reason, history, iterations, cause = self._newton(snes, x)
             if reason <= 0:
-                failures.append((target, reason, history))
-                if len(failures) > max_cuts:
+                failures.append(FailedAttempt(target, reason, history, cause))
+                stepper.failed()
+                if stepper.exhausted:
                     raise ContactDivergenceError(target, failures)
                 saved.copy(self.u.vector)
                 self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT,
                                           mode=PETSc.ScatterMode.FORWARD)
-                step /= 2
                 continue
             failures = []
             x.copy(self.u.vector)
@@ -758,9 +760,10 @@ class ContactProblem:
             s = StepResult(target, iterations, history,
                            time.perf_counter() - clock, active)
             result.steps.append(s)
-            reached = target
+            before = stepper.fraction_of_steps
+            stepper.succeeded()
             if bar is not None:
-                bar.update(step * load_steps)
+                bar.update(stepper.fraction_of_steps - before)
             if output is not None:
                 self._write_step(target, state)
             if on_step is not None:

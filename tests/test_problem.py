@@ -160,23 +160,127 @@ def test_jacobian_matches_finite_differences(kind, obstacle):
     assert fd.norm() < 1e-4 * Jdx.norm()   # a kink crossing would break this: h is tiny
 
 
+def solve_with_options(problem: ContactProblem, options: dict, **kwargs):
+    """``problem.solve(**kwargs)`` with PETSc options under a prefix of its own."""
+    prefix = f"test_{abs(hash(tuple(options.items())))}_"
+    opts = PETSc.Options()
+    for key, value in options.items():
+        opts[prefix + key] = value
+    try:
+        return problem.solve(prefix=prefix, **kwargs)
+    finally:
+        for key in options:
+            opts.delValue(prefix + key)
+
+
 def test_divergence_error_carries_the_residual_history():
     V, tags = block_on_plane()
     problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
                              kind="LcLS*", penalty=1e4, fixed={3: {0: 0.0}},
                              tractions={2: [0.0, -0.01]})
-    opts = PETSc.Options()
-    opts["starved_snes_max_it"] = 1
-    opts["starved_snes_rtol"] = 1e-30
-    opts["starved_snes_atol"] = 1e-30
-    try:
-        with pytest.raises(ContactDivergenceError) as err:
-            problem.solve(load_steps=1, max_cuts=2, prefix="starved_")
-    finally:
-        for key in ("snes_max_it", "snes_rtol", "snes_atol"):
-            opts.delValue("starved_" + key)
+    with pytest.raises(ContactDivergenceError) as err:
+        solve_with_options(problem, {"snes_max_it": 1, "snes_rtol": 1e-30, "snes_atol": 1e-30},
+                           load_steps=1, max_cuts=2)
     assert len(err.value.history) == 3
     assert "residuals" in str(err.value) and err.value.history[0][2]
+    # the cause in words, not "SNES reason -5"
+    assert "maximum Newton iterations (1) reached" in str(err.value), str(err.value)
+    assert "reason -" not in str(err.value)
+
+
+def test_a_failed_linear_solve_is_named_with_the_ksp_reason():
+    V, tags = block_on_plane()
+    problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
+                             kind="LcLS*", penalty=1e4, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    with pytest.raises(ContactDivergenceError) as err:
+        solve_with_options(problem, {"ksp_type": "cg", "pc_type": "none", "ksp_max_it": 2},
+                           load_steps=1, max_cuts=0)
+    assert ("DIVERGED_LINEAR_SOLVE: linear solve failed: KSP DIVERGED_MAX_IT after 2 "
+            "iterations") in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("load_steps", [1.5, float("nan"), 0, -2, True, "3"])
+def test_load_steps_must_be_a_positive_integer(load_steps):
+    V, tags = block_on_plane()
+    problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
+                             penalty=1e4, fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]})
+    with pytest.raises(ValueError, match=f"load_steps must be a positive integer, got "
+                                         f"{load_steps!r}"):
+        problem.solve(load_steps=load_steps)
+    assert len(problem.solve(load_steps=np.int64(2)).steps) == 2
+
+
+def test_load_stepper_regrows_a_cut_step_and_lands_on_full_load():
+    from dolfinx_mortar.load_stepping import LoadStepper
+    stepper = LoadStepper(6)
+    stepper.failed()                          # the first step fails once
+    reached = []
+    while not stepper.done:
+        reached.append(stepper.target())
+        stepper.succeeded()
+    # 1/12, 1/12, then back to 1/6: 7 steps (halved to the end: 12)
+    assert reached == pytest.approx([1 / 12, 1 / 6, 2 / 6, 3 / 6, 4 / 6, 5 / 6, 1.0])
+    assert reached[-1] == 1.0
+    thirds = LoadStepper(3)
+    loads = []
+    while not thirds.done:
+        loads.append(thirds.target())
+        thirds.succeeded()
+    assert len(loads) == 3 and loads[-1] == 1.0   # exactly, though 3 × (1/3) is not
+    exhausted = LoadStepper(2, max_cuts=1)
+    exhausted.failed()
+    assert not exhausted.exhausted
+    exhausted.failed()
+    assert exhausted.exhausted
+
+
+def test_a_cut_step_grows_back():
+    """Newton limited to 4 iterations: the step to 5/6 of a disk contact needs 5,
+    fails and is halved; two steps later the step is 1/6 again."""
+    V, tags = block_on_plane(n=(10, 4))
+    problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -3.0], 3.0), E=1.0,
+                             nu=0.3, kind="LcLS*", penalty=100.0, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    result = solve_with_options(problem, {"snes_max_it": 4}, load_steps=6)
+    loads = [s.load_factor for s in result.steps]
+    # halved to the end this was 8 steps: ..., 0.75, 0.8333, 0.9167, 1
+    assert loads == pytest.approx([1 / 6, 2 / 6, 3 / 6, 4 / 6, 0.75, 5 / 6, 1.0])
+    assert loads[-1] == 1.0
+
+
+def test_a_huge_penalty_is_balanced_or_refused():
+    """ε = 1e12 E/h on a block on a tilted plane: Newton's step reaches round-off
+    while the residual is 3e-5 of the load. That step was accepted, with the
+    force balance off by 6e-4; it must either balance or be refused, saying why."""
+    V, tags = block_on_plane(n=(8, 4))
+    normal = np.array([0.1, 1.0])
+    problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], normal), E=1.0, nu=0.3,
+                             kind="LcLS*", penalty=1e12 * 8, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    try:
+        problem.solve(load_steps=2, max_cuts=1)
+    except ContactDivergenceError as err:
+        assert "Newton step at round-off" in str(err) and "reference force" in str(err)
+        return
+    # the vertical load is carried by the normal contact force alone
+    balance = problem.contact_force() * normal[1] / np.linalg.norm(normal) / 0.01 - 1
+    assert abs(balance) < 1e-6
+
+
+def test_a_stalled_newton_is_cut_back_early():
+    """ε = 1e12 E/h against a disk with LmLS: the residual does not move. Each
+    attempt took the 40 iterations of snes_max_it; a stall stops it after 8."""
+    V, tags = block_on_plane(n=(8, 4))
+    problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -3.0], 3.0), E=1.0,
+                             nu=0.3, kind="LmLS", penalty=1e12 * 8, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    with pytest.raises(ContactDivergenceError) as err:
+        problem.solve(load_steps=2, max_cuts=2)
+    assert len(err.value.history) == 3
+    assert all(len(a.residuals) - 1 <= 8 for a in err.value.history), err.value
+    assert all(a.cause.startswith("stalled: the residual changed by only")
+               for a in err.value.history)
 
 
 def test_converged_steps_are_written_to_xdmf(tmp_path_factory):
@@ -404,3 +508,27 @@ def test_first_touch_with_positive_mortar_functions_converges():
     assert figures["contact_force"] == pytest.approx(figures["force"], rel=1e-8)
     assert figures["load_steps"] == 3   # no cut-back
     assert figures["newton_iterations"] <= 20
+
+
+@pytest.mark.parametrize("kind", ["GLS", "GLS*"])
+def test_gls_first_touch_starts_from_the_closed_gap(kind):
+    """A block 1e-3 above a disk: no d̄_A > 0 at the start. GLS kinds skipped
+    the gap-closing start and crept towards the disk by 0.015% of the residual
+    per iteration until every cut-back had failed; now the first step
+    converges, and the cycles between active sets at full load are cut short."""
+    V, tags = block_on_plane(n=(10, 4))
+    problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -3.0], 2.999), E=1.0,
+                             nu=0.3, kind=kind, penalty=1e4, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, -0.01]})
+    attempts = []
+    newton = problem._newton
+
+    def counted(snes, x):
+        outcome = newton(snes, x)
+        attempts.append(outcome[2])
+        return outcome
+    problem._newton = counted
+    result = problem.solve(load_steps=2)
+    assert result.steps[0].load_factor == 0.5 and result.steps[0].newton_iterations <= 6
+    assert result.steps[-1].load_factor == 1.0 and problem.contact_force() > 0
+    assert max(attempts) <= 15, attempts   # cycles of period 2 and 3 ran to 40
