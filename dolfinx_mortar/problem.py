@@ -683,7 +683,10 @@ class ContactProblem:
             finally:
                 if current is not None:
                     self.gap_model = current
-            self._check_petsc_options(snes.getOptionsPrefix())
+            if not self._options_checked:
+                # every option is read by the first solve: once per solve() is enough
+                self._check_petsc_options(snes.getOptionsPrefix())
+                self._options_checked = True
             reason = snes.getConvergedReason()
             history += list(snes.getConvergenceHistory()[0])
             iterations += snes.getIterationNumber()
@@ -720,6 +723,7 @@ class ContactProblem:
         if output is not None:
             self._open_output(Path(output))
         snes = self._snes(prefix)
+        self._options_checked = False
         result = SolveResult()
         failures: list[FailedAttempt] = []
         bar = None
