@@ -41,9 +41,9 @@ from tqdm import tqdm
 
 from dolfinx_mortar import KIND_NAMES, MortarBasis, _kernels, nurbs
 from dolfinx_mortar.kinds import is_global, parse_kind
-from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import MassMatrixSolver
-from dolfinx_mortar.output import save_figure, write_atomically
+from dolfinx_mortar.io.output import save_figure, write_atomically
 
 DEFAULT_CSV = Path("results/bench_basis_construction.csv")
 DEFAULT_PNG = Path("results/bench_basis_construction.png")

@@ -23,9 +23,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from dolfinx_mortar.mortar import MortarCoupling  # noqa: E402
-from dolfinx_mortar.output import save_figure, write_atomically  # noqa: E402
-from dolfinx_mortar.structured import flat_line, flat_patch  # noqa: E402
+from dolfinx_mortar.mortar.coupling import MortarCoupling  # noqa: E402
+from dolfinx_mortar.io.output import save_figure, write_atomically  # noqa: E402
+from dolfinx_mortar.surfaces.structured import flat_line, flat_patch  # noqa: E402
 
 #: name: (cell, degree, facets per lattice square)
 CASES = {

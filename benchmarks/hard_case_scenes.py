@@ -93,7 +93,7 @@ def newton_matrix(problem):
     dofs).
     """
     import scipy.sparse
-    from dolfinx_mortar.contact_terms import GlobalGap
+    from dolfinx_mortar.contact.gaps import GlobalGap
     u = problem.u.vector
     J = problem._total_matrix()
     problem._residual(None, u, problem.b)
@@ -208,9 +208,9 @@ def sweep(kinds=ALL_KINDS, nx: int = 8, offsets=SWEEP_OFFSETS, penalty: float = 
     Dual kinds also with the consistent boundary modification.
     """
     from dolfinx import fem, mesh
-    from dolfinx_mortar.facet_surface import facet_surface
+    from dolfinx_mortar.surfaces.facet_surface import facet_surface
     from dolfinx_mortar.kinds import is_partition_of_unity, parse_kind
-    from dolfinx_mortar.mortar import MortarCoupling, to_scipy
+    from dolfinx_mortar.mortar.coupling import MortarCoupling, to_scipy
     comm = MPI.COMM_SELF
     h = 1.0 / nx
     lower = mesh.create_rectangle(comm, [[0, -0.5], [1, 0]], [nx, 4])
@@ -276,8 +276,8 @@ def quadratic_identities(kind: str, slave_type: str) -> dict:
     transferred exactly: ``D·f_s = M·f_m`` for f = 1, x, y (for GLS/GLS* on the
     slave-basis factors, S cancels); the covered area must be the slave area.
     """
-    from dolfinx_mortar.mortar import MortarCoupling, to_scipy
-    from dolfinx_mortar.structured import flat_patch
+    from dolfinx_mortar.mortar.coupling import MortarCoupling, to_scipy
+    from dolfinx_mortar.surfaces.structured import flat_patch
     cell, serendipity = {"P2-triangle": ("triangle", False), "Q8": ("quadrilateral", True),
                          "Q9": ("quadrilateral", False)}[slave_type]
     transform = slave_type != "Q9"
@@ -322,8 +322,8 @@ def hertz2d_problem(kind: str, penalty_factor: float, refine: float = 0.3,
     import importlib.util
     from pathlib import Path
     from dolfinx import fem
-    from dolfinx_mortar.obstacles import RigidPlane
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.contact.obstacles import RigidPlane
+    from dolfinx_mortar.solver.problem import ContactProblem
     path = Path(__file__).resolve().parent.parent / "demos" / "hertz2d.py"
     spec = importlib.util.spec_from_file_location("hertz2d", path)
     demo = importlib.util.module_from_spec(spec)
@@ -377,7 +377,7 @@ def disk_with_neck_mesh(R: float, h_contact: float, comm: MPI.Comm):
     Tags: 1 the arc (slave), 2 the top y = 1.5R, 3 the left side x = −R.
     """
     import gmsh
-    from dolfinx_mortar.gmsh_io import grade_towards_point
+    from dolfinx_mortar.io.gmsh_io import grade_towards_point
 
     def build() -> None:
         occ = gmsh.model.occ
@@ -416,8 +416,8 @@ def grazing(kind: str, force: float = 0.01, shear: float = 0.1, h_contact: float
     the top is held tangentially (u_x = 0), which removes the sliding mode and
     the rolling about the centre. Equilibrium in y: contact force = F."""
     from dolfinx import fem
-    from dolfinx_mortar.obstacles import RigidPlane
-    from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
+    from dolfinx_mortar.contact.obstacles import RigidPlane
+    from dolfinx_mortar.solver.problem import ContactDivergenceError, ContactProblem
     R, E, nu = 1.0, 1.0, 0.3
     domain, tags = disk_with_neck_mesh(R, h_contact, MPI.COMM_WORLD)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
@@ -518,8 +518,8 @@ def coincident_patch(kind: str, cell: str = "tetrahedron", mirror_upper: bool = 
     """Patch test on two stacked blocks with coincident interface meshes (up to
     in-plane ``noise`` relative to the element size on the master's nodes)."""
     from dolfinx import fem
-    from dolfinx_mortar.mortar import MortarCoupling
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.mortar.coupling import MortarCoupling
+    from dolfinx_mortar.solver.problem import ContactProblem
     comm = MPI.COMM_WORLD
     domain, tags = stacked_boxes(cell, n, mirror_upper, comm, noise=noise)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
@@ -569,7 +569,7 @@ def two_cylinders_mesh(R1: float, R2: float, h_contact: float, a: float, comm: M
     5 fixed y = −R2.
     """
     import gmsh
-    from dolfinx_mortar.gmsh_io import grade_towards_point
+    from dolfinx_mortar.io.gmsh_io import grade_towards_point
 
     def build() -> None:
         occ = gmsh.model.occ
@@ -623,7 +623,7 @@ def two_cylinders(kind: str, R1: float = 1.0, R2: float = 2.0, force: float = 0.
     """Two elastic cylinders (plane strain, same material) against Hertz with
     1/R = 1/R1 + 1/R2 and E* = E/(2(1−ν²))."""
     from dolfinx import fem
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.solver.problem import ContactProblem
     E, nu = 1.0, 0.3
     R = R1 * R2 / (R1 + R2)
     E_star = E / (2 * (1 - nu ** 2))
@@ -665,7 +665,7 @@ def two_spheres_mesh(R1: float, R2: float, h_contact: float, a: float, comm: MPI
     """
     import gmsh
     from dolfinx import mesh as dmesh
-    from dolfinx_mortar.gmsh_io import grade_towards_point
+    from dolfinx_mortar.io.gmsh_io import grade_towards_point
 
     def build() -> None:
         occ = gmsh.model.occ
@@ -704,7 +704,7 @@ def two_spheres(kind: str, R1: float = 1.0, R2: float = 1.0, force: float = 0.00
     """
     import time
     from dolfinx import fem
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.solver.problem import ContactProblem
     clock = time.perf_counter()
     E, nu = 1.0, 0.3
     R = R1 * R2 / (R1 + R2)
@@ -809,7 +809,7 @@ def elastic_sweep(kind: str, modification: bool, slivers=SLIVERS, dim: int = 2) 
     """cond of the Newton matrix at the solution while the master's edge leaves
     a sliver·h of a slave facet covered (upper block pressed 1.5·GAP down)."""
     from dolfinx import fem
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.solver.problem import ContactProblem
     out = {"case": "sweep-elastic", "kind": kind, "modified": modification, "dim": dim,
            "slivers": list(slivers), "cond_J": [], "newton": [], "p_ratio": []}
     for sliver in slivers:
@@ -897,7 +897,7 @@ def spurious_gap(kind: str, refine: float = 0.15) -> dict:
     largest d̄ over all slave nodes and over the nodes with no master below
     them (those get contact forces in the residual but no stiffness)."""
     from dolfinx import fem
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.solver.problem import ContactProblem
     a = 0.124
     h = a / (40 * refine)
     domain, tags = two_cylinders_mesh(1.0, 2.0, h, a, MPI.COMM_WORLD)

@@ -50,7 +50,7 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from dolfinx_mortar.output import save_figure, write_atomically, write_csv  # noqa: E402
+from dolfinx_mortar.io.output import save_figure, write_atomically, write_csv  # noqa: E402
 
 DEMOS = Path(__file__).resolve().parent.parent / "demos"
 KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
@@ -75,7 +75,7 @@ def load_demo(name: str):
 
 def setup_times(problem) -> dict:
     """Contact setup phases of a freshly built problem (seconds, this rank)."""
-    from dolfinx_mortar.contact_terms import GlobalGap
+    from dolfinx_mortar.contact.gaps import GlobalGap
     model = problem.gap_model
     inner = model.inner if isinstance(model, GlobalGap) else model
     basis = inner.basis.construction_time
@@ -93,7 +93,7 @@ def setup_times(problem) -> dict:
 def run(scene: str, demo, obstacle: str, level: float, kind: str, penalty: float,
         comm: MPI.Comm, max_cuts: int = 2) -> dict:
     """One solve; times are the maximum over ranks."""
-    from dolfinx_mortar.contact_terms import GlobalGap
+    from dolfinx_mortar.contact.gaps import GlobalGap
     args = demo.parse_args(["--refine", repr(level), "--kind", kind, "--penalty", repr(penalty),
                             "--obstacle", obstacle])
     row = {"scene": scene, "obstacle": obstacle, "refine": level, "kind": kind,

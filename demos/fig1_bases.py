@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 
 from dolfinx_mortar import KIND_NAMES, MortarBasis, nurbs  # noqa: E402
 from dolfinx_mortar.kinds import is_partition_of_unity  # noqa: E402
-from dolfinx_mortar.output import save_figure, write_json  # noqa: E402
+from dolfinx_mortar.io.output import save_figure, write_json  # noqa: E402
 
 DESCRIPTION = {
     "GLS": "global least squares  M = N L⁻¹",

@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 
 from dolfinx_mortar import KIND_NAMES, MortarBasis, nurbs  # noqa: E402
 from dolfinx_mortar.kinds import is_partition_of_unity, kind_name, unstarred_partner  # noqa: E402
-from dolfinx_mortar.output import save_figure, write_json  # noqa: E402
+from dolfinx_mortar.io.output import save_figure, write_json  # noqa: E402
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:

@@ -22,9 +22,9 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.cli import (add_contact_options, parse_args_and_petsc_options,
+from dolfinx_mortar.demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
                                 solver_demo_parser)
-from dolfinx_mortar.output import write_json
+from dolfinx_mortar.io.output import write_json
 
 SLAVE, MASTER, SYMMETRY, LOAD, FIXED = 1, 2, 3, 4, 5
 
@@ -62,7 +62,7 @@ def build_mesh(args, a: float, comm: MPI.Comm):
     """Quarter disk (and block), graded towards the contact point (0, 0)."""
     import gmsh
     from dolfinx.io import gmshio
-    from dolfinx_mortar.gmsh_io import grade_towards_point
+    from dolfinx_mortar.io.gmsh_io import grade_towards_point
     R = args.radius
     h_contact = a / (40 * args.refine)
     gmsh.initialize(["", "-v", "0"])
@@ -148,8 +148,8 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
     element size.
     """
     from dolfinx import fem
-    from dolfinx_mortar.obstacles import RigidPlane
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.contact.obstacles import RigidPlane
+    from dolfinx_mortar.solver.problem import ContactProblem
     ref = hertz(args)
     domain, facet_tags, h_contact = build_mesh(args, ref["a"], comm)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", args.degree))

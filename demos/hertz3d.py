@@ -30,9 +30,9 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.cli import (add_contact_options, parse_args_and_petsc_options,
+from dolfinx_mortar.demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
                                 solver_demo_parser)
-from dolfinx_mortar.output import write_json
+from dolfinx_mortar.io.output import write_json
 
 NAMES = ("slave", "master", "fixed", "load", "sym_x", "sym_y")
 SLAVE, MASTER, FIXED, LOAD, SYM_X, SYM_Y = range(1, 7)
@@ -76,7 +76,7 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
     solve the very same mesh."""
     import gmsh
     from dolfinx.io import gmshio
-    from dolfinx_mortar.gmsh_io import grade_towards_point
+    from dolfinx_mortar.io.gmsh_io import grade_towards_point
     R = args.radius
     h_contact = a / (8 * args.refine)
     gmsh.initialize(["", "-v", "0"])
@@ -128,7 +128,7 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
 
 def read_mesh(path: str, comm: MPI.Comm):
     """A gmsh file and the tag of each named physical surface group present."""
-    from dolfinx_mortar.gmsh_io import read_gmsh
+    from dolfinx_mortar.io.gmsh_io import read_gmsh
     domain, _, facet_tags, names = read_gmsh(path, comm, gdim=3)
     tags = names.get(2, {})
     unknown = set(tags) - set(NAMES) - {""}
@@ -176,8 +176,8 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
     """
     from dolfinx import fem
     import ufl
-    from dolfinx_mortar.obstacles import RigidPlane
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.contact.obstacles import RigidPlane
+    from dolfinx_mortar.solver.problem import ContactProblem
     E_star = args.E / (1 - args.nu ** 2)
     if args.mesh is None:
         factor = 2.0 if args.obstacle == "elastic" else 1.0  # E* halves for two bodies
@@ -188,7 +188,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
         h_contact = args.h_contact
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
     if h_contact is None:
-        from dolfinx_mortar.facet_surface import facet_surface
+        from dolfinx_mortar.surfaces.facet_surface import facet_surface
         s = facet_surface(V, facet_tags, names["slave"])
         local = np.min(np.ptp(s.x[s.cells], axis=1).max(axis=1), initial=np.inf)
         h_contact = comm.allreduce(float(local), op=MPI.MIN)

@@ -17,8 +17,8 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.cli import parse_args_and_petsc_options, solver_demo_parser
-from dolfinx_mortar.output import write_json
+from dolfinx_mortar.demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
+from dolfinx_mortar.io.output import write_json
 
 LOWER_TOP, UPPER_BOTTOM, TOP, BOTTOM, SYM_X, SYM_Y = 1, 2, 3, 4, 5, 6
 ALL_KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
@@ -93,7 +93,7 @@ def build_mesh(dim: int, h_lower: float, h_upper: float, degree: int, comm: MPI.
 
 def run(args, orientation: str, kind: str, scaling: str, comm=MPI.COMM_WORLD) -> dict:
     from dolfinx import fem
-    from dolfinx_mortar.problem import ContactProblem
+    from dolfinx_mortar.solver.problem import ContactProblem
     fine, coarse = args.fine, args.coarse
     # the slave is the lower block's top
     h_lower, h_upper = (fine, coarse) if orientation == "finer-slave" else (coarse, fine)

@@ -3,11 +3,47 @@
 The six mortar bases for the contact pressure of Duong, De Lorenzis and Sauer
 (GLS, GLS*, LmLS, LmLS*, LcLS*, LcLS) on B-spline/NURBS and Lagrange slave
 surfaces; see DESIGN.md for the mathematics.
+
+Subpackages, one per layer of the Python library:
+
+- :mod:`~dolfinx_mortar.surfaces`: slave and master surfaces (Lagrange, NURBS,
+  DOLFINx facets);
+- :mod:`~dolfinx_mortar.bases`: the six mortar bases;
+- :mod:`~dolfinx_mortar.mortar`: segmentation and mortar operators;
+- :mod:`~dolfinx_mortar.contact`: gap models, rigid obstacles and the contact
+  term that adds penalty contact to a DOLFINx model;
+- :mod:`~dolfinx_mortar.solver`: the nonlinear problem, Newton and the load path;
+- :mod:`~dolfinx_mortar.io`: XDMF series, gmsh, merged meshes, result files.
+
+The names that need DOLFINx (``ContactTerm``, ``NonlinearContactProblem``,
+``LoadPathSolver``, ``ContactProblem``, the obstacles) are imported on first
+use, so that the bases and kernels work without it.
 """
-from dolfinx_mortar import basis, kinds, lagrange, nurbs
-from dolfinx_mortar.basis import MortarBasis
+from importlib import import_module
+
+from dolfinx_mortar import kinds
+from dolfinx_mortar.bases import basis
+from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import KIND_NAMES, parse_kind
+from dolfinx_mortar.surfaces import lagrange, nurbs
+
+_LAZY = {
+    "ContactTerm": "dolfinx_mortar.contact.term",
+    "NonlinearContactProblem": "dolfinx_mortar.solver.nonlinear_problem",
+    "LoadPathSolver": "dolfinx_mortar.solver.load_path",
+    "ContactProblem": "dolfinx_mortar.solver.elastic",
+    "ContactDivergenceError": "dolfinx_mortar.solver.convergence",
+    "RigidPlane": "dolfinx_mortar.contact.obstacles",
+    "RigidSphere": "dolfinx_mortar.contact.obstacles",
+    "RigidCylinder": "dolfinx_mortar.contact.obstacles",
+}
 
 __all__ = ["basis", "kinds", "lagrange", "nurbs", "MortarBasis", "KIND_NAMES",
-           "parse_kind"]
-__version__ = "0.1.0"
+           "parse_kind", *_LAZY]
+__version__ = "0.2.0"
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        return getattr(import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'dolfinx_mortar' has no attribute '{name}'")

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from dolfinx_mortar.lagrange import LagrangeSurface
-from dolfinx_mortar.structured import (compact_nodes, flat_line, flat_patch,  # noqa: F401
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+from dolfinx_mortar.surfaces.structured import (compact_nodes, flat_line, flat_patch,  # noqa: F401
                                        lattice_cells, line_chain)
 
 

@@ -8,8 +8,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.kinds import parse_kind
-from dolfinx_mortar.obstacles import RigidPlane
-from dolfinx_mortar.problem import ContactProblem
+from dolfinx_mortar.contact.obstacles import RigidPlane
+from dolfinx_mortar.solver.problem import ContactProblem
 from meshes import rectangle
 
 PLANE = RigidPlane([0, 0], [0, 1])

@@ -197,7 +197,7 @@ def test_gls_projection_converges_at_order_p_plus_one(degree):
 @pytest.mark.parametrize("cell, serendipity, vertex, edge", [
     ("triangle", False, 2 / 15, 1 / 5), ("quadrilateral", True, 1 / 20, 1 / 5)])
 def test_transformed_quadratic_basis_has_positive_integrals(cell, serendipity, vertex, edge):
-    from dolfinx_mortar.lagrange import ReferenceLagrange
+    from dolfinx_mortar.surfaces.lagrange import ReferenceLagrange
     import basix
     ref = ReferenceLagrange(cell, 2, serendipity=serendipity, quadratic_transform=True)
     X, wq = basix.make_quadrature(ref.cell_type, 6)

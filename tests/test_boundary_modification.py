@@ -6,7 +6,7 @@ import pytest
 from dolfinx import fem
 from mpi4py import MPI
 
-from dolfinx_mortar.problem import ContactProblem
+from dolfinx_mortar.solver.problem import ContactProblem
 from jacobian_check import jacobian_error
 
 GAP = 0.05

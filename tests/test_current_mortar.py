@@ -7,7 +7,7 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar.problem import ContactProblem
+from dolfinx_mortar.solver.problem import ContactProblem
 from jacobian_check import convergence_order, jacobian_error, newton_history
 from test_finite_deformation import _energy_gradient_error
 from test_problem import LOCAL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks, load
@@ -242,8 +242,8 @@ def test_jet_clipping_conserves_the_area_of_near_coincident_triangles():
     equal up to vertex moves of 1e-16 … 1e-9 overlap in the triangle, up to the
     tolerance times the perimeter (crossings extrapolated off their edges gave
     up to several times its area before)."""
-    from dolfinx_mortar.current_mortar_3d import _signed_area, clip_polygon
-    from dolfinx_mortar.jet import Jet
+    from dolfinx_mortar.contact.current_mortar_3d import _signed_area, clip_polygon
+    from dolfinx_mortar.contact.jet import Jet
     rng = np.random.default_rng(3)
     tolerance, worst = 1e-10, 0.0
     for _ in range(300):

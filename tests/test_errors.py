@@ -7,9 +7,9 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from dolfinx_mortar import MortarBasis, _kernels, basis, nurbs
-from dolfinx_mortar.facet_surface import facet_surface
-from dolfinx_mortar.lagrange import LagrangeSurface
-from dolfinx_mortar.mortar import MortarCoupling
+from dolfinx_mortar.surfaces.facet_surface import facet_surface
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+from dolfinx_mortar.mortar.coupling import MortarCoupling
 
 from surfaces import curved_patch
 

@@ -15,7 +15,7 @@ from petsc4py import PETSc
 from scipy.spatial import cKDTree
 
 from dolfinx_mortar import KIND_NAMES, MortarBasis
-from dolfinx_mortar.facet_surface import facet_surface
+from dolfinx_mortar.surfaces.facet_surface import facet_surface
 
 SLAVE = 7
 

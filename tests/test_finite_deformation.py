@@ -6,10 +6,10 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar.facet_surface import nodal_displacement
-from dolfinx_mortar.finite_deformation import area_element_derivatives
-from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
-from dolfinx_mortar.problem import ContactProblem
+from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
+from dolfinx_mortar.contact.finite_deformation import area_element_derivatives
+from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
+from dolfinx_mortar.solver.problem import ContactProblem
 from jacobian_check import convergence_order, jacobian_error, newton_history
 from test_problem import LOCAL_KINDS, block_on_plane, load, pressed_block
 

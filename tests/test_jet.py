@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dolfinx_mortar.jet import Jet, maximum, minimum
+from dolfinx_mortar.contact.jet import Jet, maximum, minimum
 
 
 def composite(v):

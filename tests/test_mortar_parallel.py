@@ -11,8 +11,8 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 from scipy.spatial import cKDTree
 
-from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
-from dolfinx_mortar.mortar import MortarCoupling
+from dolfinx_mortar.surfaces.facet_surface import facet_surface, nodal_displacement
+from dolfinx_mortar.mortar.coupling import MortarCoupling
 
 SLAVE, MASTER = 1, 2
 

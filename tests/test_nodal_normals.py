@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from dolfinx_mortar.kinds import is_partition_of_unity, parse_kind
-from dolfinx_mortar.lagrange import LagrangeSurface
-from dolfinx_mortar.mortar import MortarCoupling, averaged_nodal_normals
-from dolfinx_mortar.structured import flat_line
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+from dolfinx_mortar.mortar.coupling import MortarCoupling, averaged_nodal_normals
+from dolfinx_mortar.surfaces.structured import flat_line
 
 ALL_KINDS = ["GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS"]
 GAP = 0.01

@@ -1,5 +1,5 @@
 """XDMF output survives a crash: after SIGKILL at any moment, the index parses and
-every step it names can be read from its .h5 (dolfinx_mortar.xdmf_series).
+every step it names can be read from its .h5 (dolfinx_mortar.io.xdmf_series).
 
 h5py is not installed (Debian 12 without python3-h5py): datasets are read back
 with PETSc's HDF5 viewer, which also gives their sizes.
@@ -19,9 +19,9 @@ import pytest
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.obstacles import RigidPlane
-from dolfinx_mortar.problem import ContactProblem
-from dolfinx_mortar.surface_output import surface_output_path
+from dolfinx_mortar.contact.obstacles import RigidPlane
+from dolfinx_mortar.solver.problem import ContactProblem
+from dolfinx_mortar.io.surface_output import surface_output_path
 from test_problem import block_on_plane
 
 CHILD = Path(__file__).resolve().parent / "output_child.py"

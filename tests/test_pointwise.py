@@ -6,9 +6,9 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar.cut_quadrature import positive_part_rule
-from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
-from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
+from dolfinx_mortar.contact.cut_quadrature import positive_part_rule
+from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
+from dolfinx_mortar.solver.problem import ContactDivergenceError, ContactProblem
 from jacobian_check import jacobian_error
 from test_problem import ALL_KINDS, block_on_plane, load, pressed_block
 

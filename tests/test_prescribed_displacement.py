@@ -17,8 +17,8 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
-from dolfinx_mortar.problem import ContactProblem
+from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
+from dolfinx_mortar.solver.problem import ContactProblem
 from meshes import rectangle
 
 ALL_KINDS = ["GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS"]

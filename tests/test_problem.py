@@ -10,8 +10,8 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.obstacles import RigidPlane, RigidSphere
-from dolfinx_mortar.problem import ContactDivergenceError, ContactProblem
+from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
+from dolfinx_mortar.solver.problem import ContactDivergenceError, ContactProblem
 from jacobian_check import residual_difference
 from meshes import rectangle
 
@@ -212,7 +212,7 @@ def test_load_steps_must_be_a_positive_integer(load_steps):
 
 
 def test_load_stepper_regrows_a_cut_step_and_lands_on_full_load():
-    from dolfinx_mortar.load_stepping import LoadStepper
+    from dolfinx_mortar.solver.load_stepping import LoadStepper
     stepper = LoadStepper(6)
     stepper.failed()                          # the first step fails once
     reached = []
@@ -305,7 +305,7 @@ def test_mortar_traction_on_the_slave_surface_mesh(kind, tmp_path_factory):
     """p* is the traction: it equals the applied pressure on a block on a plane,
     integrates to the contact force, and the broken surface mesh carries it
     node by node."""
-    from dolfinx_mortar.surface_output import SlaveSurfaceOutput
+    from dolfinx_mortar.io.surface_output import SlaveSurfaceOutput
     V, tags = block_on_plane(n=(9, 3))
     problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
                              kind=kind, penalty=1e4, fixed={3: {0: 0.0}},

@@ -6,8 +6,8 @@ import pytest
 from petsc4py import PETSc
 
 from dolfinx_mortar import KIND_NAMES, _kernels
-from dolfinx_mortar.lagrange import LagrangeSurface, ReferenceLagrange
-from dolfinx_mortar.mortar import MortarCoupling, to_scipy
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface, ReferenceLagrange
+from dolfinx_mortar.mortar.coupling import MortarCoupling, to_scipy
 
 from surfaces import flat_line, flat_patch
 
@@ -258,7 +258,7 @@ def test_mismatched_dimensions_are_reported():
     with pytest.raises(ValueError, match="different dimensions"):
         MortarCoupling(flat_line(1, 3), flat_patch("triangle", 1, 2, 2))
     slave = flat_line(1, 3)
-    from dolfinx_mortar.mortar import current_coordinates
+    from dolfinx_mortar.mortar.coupling import current_coordinates
     with pytest.raises(ValueError, match="NaN"):
         current_coordinates(slave, np.full(slave.x.shape, np.nan))
 

@@ -18,7 +18,7 @@ area element (``∂J/∂F = J F G⁻¹`` with ``G = FᵀF``) and of W.
 :class:`CurrentSurfaceGap` holds what does not depend on where the gap comes
 from (W, the nodal energy, residual and Jacobian assembly);
 :class:`CurrentObstacleGap` takes d from a rigid obstacle and
-:class:`~dolfinx_mortar.current_mortar.CurrentMortarGap` from an elastic
+:class:`~dolfinx_mortar.contact.current_mortar.CurrentMortarGap` from an elastic
 master. GLS/GLS* (L depends on u through every facet) are not covered.
 """
 from __future__ import annotations
@@ -30,11 +30,11 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact_terms import _GapBase
+from dolfinx_mortar.contact.gaps import _GapBase
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, is_partition_of_unity, kind_name
-from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
-from dolfinx_mortar.obstacles import RigidObstacle
+from dolfinx_mortar.contact.obstacles import RigidObstacle
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -93,7 +93,7 @@ class CurrentSurfaceGap(_GapBase):
     slave
         The slave surface in the reference configuration.
     kind, penalty, scaling
-        As for :class:`~dolfinx_mortar.contact_terms.ObstacleGap`; GLS kinds are
+        As for :class:`~dolfinx_mortar.contact.gaps.ObstacleGap`; GLS kinds are
         not supported, dual kinds only on P1 lines and triangles.
     quadrature_degree
         Degree of the rule for W on every slave facet (default 2p + 2).

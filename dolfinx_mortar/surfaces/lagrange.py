@@ -14,7 +14,7 @@ import numpy.typing as npt
 
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.layout import NodeLayout
-from dolfinx_mortar.tabulation import Tabulation
+from dolfinx_mortar.surfaces.tabulation import Tabulation
 from dolfinx_mortar.tolerance import GEOMETRIC_TOLERANCE, length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]

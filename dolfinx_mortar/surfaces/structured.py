@@ -10,7 +10,7 @@ from typing import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
 
 def lattice_cells(cell: str, k: int, nx: int, ny: int, serendipity: bool) -> npt.NDArray[np.int64]:

@@ -27,9 +27,9 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.basis import MortarBasis
+from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
-from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.tolerance import length_scale, zero_length
 

@@ -9,10 +9,10 @@ For every kind, ``M_A`` is represented through the slave basis ``N``:
 
 A surface is anything with ``layout``, ``cells``, ``description``,
 ``tabulate(quadrature_degree)``, ``default_quadrature_degree()`` and
-``locate(points)``: :class:`~dolfinx_mortar.nurbs.BSplineCurve`,
-:class:`~dolfinx_mortar.nurbs.BSplineSurface`,
-:class:`~dolfinx_mortar.lagrange.LagrangeSurface` and the facet surfaces of
-:mod:`dolfinx_mortar.facet_surface`.
+``locate(points)``: :class:`~dolfinx_mortar.surfaces.nurbs.BSplineCurve`,
+:class:`~dolfinx_mortar.surfaces.nurbs.BSplineSurface`,
+:class:`~dolfinx_mortar.surfaces.lagrange.LagrangeSurface` and the facet surfaces of
+:mod:`dolfinx_mortar.surfaces.facet_surface`.
 """
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ import numpy.typing as npt
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.layout import MassMatrixSolver
-from dolfinx_mortar.tabulation import Tabulation
+from dolfinx_mortar.surfaces.tabulation import Tabulation
 from dolfinx_mortar.tolerance import length_scale
 
 FloatArray = npt.NDArray[np.float64]

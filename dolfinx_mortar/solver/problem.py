@@ -22,21 +22,21 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact_terms import GlobalGap, MortarGap, ObstacleGap, gap_kind
-from dolfinx_mortar.convergence import (ContactDivergenceError, EquilibriumTest, FailedAttempt,
+from dolfinx_mortar.contact.gaps import GlobalGap, MortarGap, ObstacleGap, gap_kind
+from dolfinx_mortar.solver.convergence import (ContactDivergenceError, EquilibriumTest, FailedAttempt,
                                         describe_failure)
-from dolfinx_mortar.facet_surface import facet_surface, nodal_displacement
-from dolfinx_mortar.current_mortar import CurrentMortarGap
-from dolfinx_mortar.finite_deformation import CurrentObstacleGap, CurrentState, CurrentSurfaceGap
-from dolfinx_mortar.input_checks import check_boundary_data, check_cells, unused_petsc_options
+from dolfinx_mortar.surfaces.facet_surface import facet_surface, nodal_displacement
+from dolfinx_mortar.contact.current_mortar import CurrentMortarGap
+from dolfinx_mortar.contact.finite_deformation import CurrentObstacleGap, CurrentState, CurrentSurfaceGap
+from dolfinx_mortar.solver.input_checks import check_boundary_data, check_cells, unused_petsc_options
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, parse_kind
-from dolfinx_mortar.load_stepping import LoadStepper
-from dolfinx_mortar.mortar import MortarCoupling
+from dolfinx_mortar.solver.load_stepping import LoadStepper
+from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.layout import assemble_blocks
-from dolfinx_mortar.obstacles import RigidObstacle
-from dolfinx_mortar.pointwise import obstacle_positive_gaps
-from dolfinx_mortar.surface_output import SlaveSurfaceOutput, surface_output_path
-from dolfinx_mortar.xdmf_series import XdmfSeries
+from dolfinx_mortar.contact.obstacles import RigidObstacle
+from dolfinx_mortar.contact.pointwise import obstacle_positive_gaps
+from dolfinx_mortar.io.surface_output import SlaveSurfaceOutput, surface_output_path
+from dolfinx_mortar.io.xdmf_series import XdmfSeries
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -52,7 +52,7 @@ DEFAULT_OPTIONS = {
     "snes_type": "newtonls",
     "snes_linesearch_type": "basic",
     # relative to the out-of-balance force where the step starts
-    # (dolfinx_mortar.convergence.EquilibriumTest)
+    # (dolfinx_mortar.solver.convergence.EquilibriumTest)
     "snes_rtol": 1e-11,
     # absolute residuals depend on the units: rely on the relative test
     "snes_atol": 1e-15,
@@ -143,7 +143,7 @@ class ContactProblem:
         ``"pointwise"``: ``p_A = ε ∫ M̄_A ⟨d⟩``, integrated only where the slave
         penetrates (cells split at d = 0 against a rigid obstacle; the segment
         quadrature points against an elastic master), with an unsymmetric
-        exact Jacobian (:mod:`dolfinx_mortar.pointwise`).
+        exact Jacobian (:mod:`dolfinx_mortar.contact.pointwise`).
     basis_configuration
         ``"initial"`` (default): bases and segmentation in the reference
         configuration; ``"previous"``: bases (and, for an elastic master, the
@@ -151,8 +151,8 @@ class ContactProblem:
         step starts; ``"current"``: bases (and, for an elastic master, the
         segmentation and the normals) on the current surfaces at every Newton
         iteration with the exact linearization (local kinds; rigid obstacles
-        in 2D and 3D, :mod:`dolfinx_mortar.finite_deformation`; elastic
-        masters on lines and P1 triangles, :mod:`dolfinx_mortar.current_mortar`).
+        in 2D and 3D, :mod:`dolfinx_mortar.contact.finite_deformation`; elastic
+        masters on lines and P1 triangles, :mod:`dolfinx_mortar.contact.current_mortar`).
     fixed
         ``{tag: {component: value}}``: prescribed displacement components at
         load factor 1 (scaled by the load factor).
@@ -706,7 +706,7 @@ class ContactProblem:
         :class:`ContactDivergenceError` is raised with every attempt's cause
         and residual history. After two successes in a row a cut step is
         doubled again, up to ``1 / load_steps``; the last step ends exactly at
-        load factor 1 (:class:`dolfinx_mortar.load_stepping.LoadStepper`).
+        load factor 1 (:class:`dolfinx_mortar.solver.load_stepping.LoadStepper`).
         Each converged step is written to ``output`` (XDMF: displacement and
         ``p̂`` on the mesh) and to ``<output stem>_slave.xdmf`` (``p̂`` and
         ``p*`` on the slave facets, one set of nodes per facet since ``p*``
@@ -819,7 +819,7 @@ class ContactProblem:
 
     def _write_step(self, t: float, state: ContactState) -> None:
         """Add the step to both files; each is complete on disk after it
-        (:mod:`dolfinx_mortar.xdmf_series`)."""
+        (:mod:`dolfinx_mortar.io.xdmf_series`)."""
         pressures = self.nodal_pressures(state)
         self._output.write(self._output_functions(pressures), t)
         self._surface_output.write({"p_hat": pressures[self.slave.cells],
@@ -849,7 +849,7 @@ class ContactProblem:
                         shared_tags: Sequence[int] = (), **kwargs) -> "ContactProblem":
         """The contact of a slave body and an elastic master meshed separately.
 
-        Merges the meshes into one (:func:`dolfinx_mortar.merge_meshes.merge_meshes`:
+        Merges the meshes into one (:func:`dolfinx_mortar.io.merge_meshes.merge_meshes`:
         same cell type and geometry degree, any MPI distribution), builds the
         vector Lagrange space of ``degree`` on it and returns the problem.
 
@@ -864,7 +864,7 @@ class ContactProblem:
             Degree of the displacement space.
         tag_offset, shared_tags
             How b's tag values enter the merged mesh: ``v + tag_offset``,
-            except ``shared_tags`` (kept); see :mod:`dolfinx_mortar.merge_meshes`.
+            except ``shared_tags`` (kept); see :mod:`dolfinx_mortar.io.merge_meshes`.
         **kwargs
             Passed to :class:`ContactProblem` (``E``, ``nu``, ``penalty``, ...).
             The keys of ``fixed`` and ``tractions`` are merged tag values.
@@ -872,7 +872,7 @@ class ContactProblem:
         The merged facet and cell tags (1 on a's cells, 2 on b's) are kept as
         ``problem.facet_tags`` and ``problem.cell_tags``.
         """
-        from dolfinx_mortar.merge_meshes import merge_meshes
+        from dolfinx_mortar.io.merge_meshes import merge_meshes
         mesh, facet_tags, cell_tags = merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b,
                                                    tag_offset=tag_offset,
                                                    shared_tags=shared_tags)

@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dolfinx_mortar.layout import NodeLayout
-from dolfinx_mortar.tabulation import Tabulation
+from dolfinx_mortar.surfaces.tabulation import Tabulation
 
 FloatArray = npt.NDArray[np.float64]
 

@@ -17,8 +17,8 @@ import ufl
 from dolfinx import cpp, fem
 from dolfinx import mesh as dmesh
 
-from dolfinx_mortar.lagrange import LagrangeSurface
-from dolfinx_mortar.xdmf_series import XdmfSeries
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+from dolfinx_mortar.io.xdmf_series import XdmfSeries
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -38,7 +38,7 @@ class SlaveSurfaceOutput:
         The slave surface (this rank's facets).
     path
         The ``.xdmf`` index; it is created with the surface mesh, its data
-        files next to it (:class:`dolfinx_mortar.xdmf_series.XdmfSeries`).
+        files next to it (:class:`dolfinx_mortar.io.xdmf_series.XdmfSeries`).
     """
 
     def __init__(self, slave: LagrangeSurface, path: Path):
@@ -76,5 +76,5 @@ class SlaveSurfaceOutput:
 
     def write(self, fields: dict[str, FloatArray], t: float) -> None:
         """Add fields (name → (cells, nd) values) at time t; the file is
-        complete on disk after every call (:mod:`dolfinx_mortar.xdmf_series`)."""
+        complete on disk after every call (:mod:`dolfinx_mortar.io.xdmf_series`)."""
         self.series.write([self.function(name, values) for name, values in fields.items()], t)

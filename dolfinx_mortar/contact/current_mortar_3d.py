@@ -1,7 +1,7 @@
 """The current-configuration mortar gap against an elastic master in 3D (P1 triangles).
 
 The same construction as ``mortar_integrals.cpp`` for flat triangles, in
-:class:`~dolfinx_mortar.jet.Jet` arithmetic: the slave triangle's plane, the
+:class:`~dolfinx_mortar.contact.jet.Jet` arithmetic: the slave triangle's plane, the
 master triangle projected onto it and clipped (Sutherland–Hodgman, the
 kernel's tolerances and merging), the clip polygon fanned from its centroid,
 each quadrature point mapped back to both triangles along the plane's normal,
@@ -22,8 +22,8 @@ from typing import Optional
 import numpy as np
 import numpy.typing as npt
 
-from dolfinx_mortar.jet import Jet, dot, stack
-from dolfinx_mortar.mortar import MortarCoupling, gather_surface
+from dolfinx_mortar.contact.jet import Jet, dot, stack
+from dolfinx_mortar.mortar.coupling import MortarCoupling, gather_surface
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]

@@ -26,13 +26,13 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
-from dolfinx_mortar.basis import MortarBasis
+from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import (BasisKind, KindLike, is_global, is_partition_of_unity,
                                   parse_kind, unstarred_partner)
-from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import MassMatrixSolver, NodeLayout, assemble_blocks
-from dolfinx_mortar.mortar import MortarCoupling
-from dolfinx_mortar.obstacles import RigidObstacle
+from dolfinx_mortar.mortar.coupling import MortarCoupling
+from dolfinx_mortar.contact.obstacles import RigidObstacle
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -223,7 +223,7 @@ class MortarGap(_GapBase):
         #: the segment points for the pointwise active set (None: nodal only)
         self.points = None
         if coupling.points is not None:
-            from dolfinx_mortar.pointwise import MortarPointGaps
+            from dolfinx_mortar.contact.pointwise import MortarPointGaps
             self.points = MortarPointGaps(self)
 
     def evaluate(self, u: PETSc.Vec) -> FloatArray:

@@ -7,13 +7,13 @@ kernel computes it (``mortar_integrals.cpp``: an auxiliary line through each
 flat slave piece, master piece ends projected onto it, the overlap integrated
 with the segment rule, every point mapped back to slave and master along the
 line's normal, ``d = (x_s − x_m)·n̂`` with n̂ the interpolated averaged nodal
-normal), but in :class:`~dolfinx_mortar.jet.Jet` arithmetic, so that ``ĝ``
+normal), but in :class:`~dolfinx_mortar.contact.jet.Jet` arithmetic, so that ``ĝ``
 comes with its exact first and second derivatives with respect to every node
 it depends on: the slave cell's, its neighbours' (through the averaged
 normals) and the master cell's. The kernel still picks the pairs; its values
 must equal these (tested), which ties the two implementations together.
 
-Lines here; P1 triangles in :mod:`dolfinx_mortar.current_mortar_3d`, where the
+Lines here; P1 triangles in :mod:`dolfinx_mortar.contact.current_mortar_3d`, where the
 same construction runs through polygon clipping.
 """
 from __future__ import annotations
@@ -24,13 +24,13 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
-from dolfinx_mortar.current_mortar_3d import TrianglePatches, pair_jets_3d
-from dolfinx_mortar.finite_deformation import CurrentSurfaceGap
-from dolfinx_mortar.jet import Jet, dot, maximum, minimum
+from dolfinx_mortar.contact.current_mortar_3d import TrianglePatches, pair_jets_3d
+from dolfinx_mortar.contact.finite_deformation import CurrentSurfaceGap
+from dolfinx_mortar.contact.jet import Jet, dot, maximum, minimum
 from dolfinx_mortar.kinds import KindLike
-from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
-from dolfinx_mortar.mortar import (MortarCoupling, _polynomial_degree, _segment_quadrature,
+from dolfinx_mortar.mortar.coupling import (MortarCoupling, _polynomial_degree, _segment_quadrature,
                                    gather_surface)
 
 FloatArray = npt.NDArray[np.float64]
@@ -115,9 +115,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
     slave, master
         The surfaces in the reference configuration (one displacement space).
     kind, penalty, scaling
-        As for :class:`~dolfinx_mortar.finite_deformation.CurrentSurfaceGap`.
+        As for :class:`~dolfinx_mortar.contact.finite_deformation.CurrentSurfaceGap`.
     search_radius
-        As for :class:`~dolfinx_mortar.mortar.MortarCoupling` (pairs are found
+        As for :class:`~dolfinx_mortar.mortar.coupling.MortarCoupling` (pairs are found
         again at every evaluation).
     """
 

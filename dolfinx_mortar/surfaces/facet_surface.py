@@ -13,7 +13,7 @@ import dolfinx
 import numpy as np
 from dolfinx import fem
 
-from dolfinx_mortar.lagrange import LagrangeSurface
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import NodeLayout
 
 _FACET_CELL = {"interval": "point", "triangle": "interval",

@@ -1,0 +1,1 @@
+"""The six mortar bases of the contact pressure (DESIGN.md §2)."""

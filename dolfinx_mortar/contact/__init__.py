@@ -1,0 +1,1 @@
+"""Gap models, rigid obstacles and the contact term added to a DOLFINx model."""

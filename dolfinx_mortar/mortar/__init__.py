@@ -1,0 +1,1 @@
+"""Slave–master segmentation and the mortar operators D, M and the raw gaps."""

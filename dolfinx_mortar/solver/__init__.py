@@ -1,0 +1,1 @@
+"""The nonlinear problem (user form + contact), Newton, and the load-path driver."""

@@ -1,0 +1,1 @@
+"""Slave and master surfaces: Lagrange facets, NURBS patches, DOLFINx facet meshtags."""
