@@ -135,7 +135,7 @@ def time_constructor(kind: str, surface: Any) -> float:
     start = time.perf_counter()
     basis = MortarBasis(kind, surface)
     elapsed = time.perf_counter() - start
-    _release_solver(getattr(basis, "_solver", None))
+    _release_solver(basis.mass_solver)
     del basis
     gc.collect()
     return elapsed

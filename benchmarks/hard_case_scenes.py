@@ -93,16 +93,14 @@ def newton_matrix(problem):
     dofs).
     """
     import scipy.sparse
-    from dolfinx_mortar.contact.gaps import GlobalGap
     u = problem.u.vector
-    J = problem._total_matrix()
-    problem._residual(None, u, problem.b)
-    if isinstance(problem.gap_model, GlobalGap):
-        saved = getattr(problem, "_augmented", None)
-        problem._augmented = _Capture()
-        problem._jacobian(None, u, J, J)
-        cap = problem._augmented
-        problem._augmented = saved
+    J = problem.problem.matrix()
+    problem.problem.F(u, problem.problem.vector())
+    problem.problem.J(u, J)
+    cap = problem.contact.augmented_step
+    if cap is not None:
+        if cap.G_linearized is not None and cap.G_linearized is not cap.G:
+            raise NotImplementedError("condition numbers of the pointwise GLS step")
         K, G, L = gather_sparse(cap.K), gather_sparse(cap.G), gather_dense(cap.L)
         w = np.concatenate(problem.mesh.comm.allgather(
             cap.weights[: problem.slave.layout.num_owned]))
@@ -113,19 +111,9 @@ def newton_matrix(problem):
         A = (K + scipy.sparse.csr_matrix((block.ravel(), (r.ravel(), c.ravel())),
                                          shape=K.shape)).tocsr()
     else:
-        problem._jacobian(None, u, J, J)
         A = gather_sparse(J)
-    free = gather_vector(problem._mask()) > 0.5
+    free = gather_vector(problem.contact.mask(problem.bcs)) > 0.5
     return A, free
-
-
-class _Capture:
-    """Stands in for AugmentedNewtonStep to capture the pieces of its matrix."""
-
-    def update(self, K, G, weights, L, G_linearized=None, surface=None):
-        if G_linearized is not None and G_linearized is not G:
-            raise NotImplementedError("condition numbers of the pointwise GLS step")
-        self.K, self.G, self.weights, self.L = K, G, weights, L
 
 
 def condition(A, free: Optional[np.ndarray] = None) -> float:
@@ -253,7 +241,7 @@ def sweep(kinds=ALL_KINDS, nx: int = 8, offsets=SWEEP_OFFSETS, penalty: float = 
                 if op.is_global:
                     coeff = np.nan
                 else:
-                    C = (c._covered_coefficients(parse_kind(kind)) if modified
+                    C = (c.covered_coefficients(parse_kind(kind)) if modified
                          else op.basis.coefficients)
                     coeff = float(np.max(np.abs(C[c.covered_area > 0])))
                 row["max_coefficient"].append(coeff)
@@ -323,7 +311,7 @@ def hertz2d_problem(kind: str, penalty_factor: float, refine: float = 0.3,
     from pathlib import Path
     from dolfinx import fem
     from dolfinx_mortar.contact.obstacles import RigidPlane
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     path = Path(__file__).resolve().parent.parent / "demos" / "hertz2d.py"
     spec = importlib.util.spec_from_file_location("hertz2d", path)
     demo = importlib.util.module_from_spec(spec)
@@ -417,7 +405,7 @@ def grazing(kind: str, force: float = 0.01, shear: float = 0.1, h_contact: float
     the rolling about the centre. Equilibrium in y: contact force = F."""
     from dolfinx import fem
     from dolfinx_mortar.contact.obstacles import RigidPlane
-    from dolfinx_mortar.solver.problem import ContactDivergenceError, ContactProblem
+    from dolfinx_mortar import ContactDivergenceError, ContactProblem
     R, E, nu = 1.0, 1.0, 0.3
     domain, tags = disk_with_neck_mesh(R, h_contact, MPI.COMM_WORLD)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
@@ -519,7 +507,7 @@ def coincident_patch(kind: str, cell: str = "tetrahedron", mirror_upper: bool = 
     in-plane ``noise`` relative to the element size on the master's nodes)."""
     from dolfinx import fem
     from dolfinx_mortar.mortar.coupling import MortarCoupling
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     comm = MPI.COMM_WORLD
     domain, tags = stacked_boxes(cell, n, mirror_upper, comm, noise=noise)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
@@ -623,7 +611,7 @@ def two_cylinders(kind: str, R1: float = 1.0, R2: float = 2.0, force: float = 0.
     """Two elastic cylinders (plane strain, same material) against Hertz with
     1/R = 1/R1 + 1/R2 and E* = E/(2(1−ν²))."""
     from dolfinx import fem
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     E, nu = 1.0, 0.3
     R = R1 * R2 / (R1 + R2)
     E_star = E / (2 * (1 - nu ** 2))
@@ -704,7 +692,7 @@ def two_spheres(kind: str, R1: float = 1.0, R2: float = 1.0, force: float = 0.00
     """
     import time
     from dolfinx import fem
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     clock = time.perf_counter()
     E, nu = 1.0, 0.3
     R = R1 * R2 / (R1 + R2)
@@ -809,7 +797,7 @@ def elastic_sweep(kind: str, modification: bool, slivers=SLIVERS, dim: int = 2) 
     """cond of the Newton matrix at the solution while the master's edge leaves
     a sliver·h of a slave facet covered (upper block pressed 1.5·GAP down)."""
     from dolfinx import fem
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     out = {"case": "sweep-elastic", "kind": kind, "modified": modification, "dim": dim,
            "slivers": list(slivers), "cond_J": [], "newton": [], "p_ratio": []}
     for sliver in slivers:
@@ -897,7 +885,7 @@ def spurious_gap(kind: str, refine: float = 0.15) -> dict:
     largest d̄ over all slave nodes and over the nodes with no master below
     them (those get contact forces in the residual but no stiffness)."""
     from dolfinx import fem
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     a = 0.124
     h = a / (40 * refine)
     domain, tags = two_cylinders_mesh(1.0, 2.0, h, a, MPI.COMM_WORLD)

@@ -75,7 +75,7 @@ def load_demo(name: str):
 
 def setup_times(problem) -> dict:
     """Contact setup phases of a freshly built problem (seconds, this rank)."""
-    from dolfinx_mortar.contact.gaps import GlobalGap
+    from dolfinx_mortar.contact.global_gap import GlobalGap
     model = problem.gap_model
     inner = model.inner if isinstance(model, GlobalGap) else model
     basis = inner.basis.construction_time
@@ -87,13 +87,12 @@ def setup_times(problem) -> dict:
         search = coupling.timings["normals_and_gather"] + coupling.timings["search"]
         segmentation = coupling.timings["segmentation"]
     return {"search": search, "segmentation": segmentation, "basis": basis,
-            "gap_setup": problem.timings_segmentation - search - segmentation - basis}
+            "gap_setup": problem.timings["contact_setup"] - search - segmentation - basis}
 
 
 def run(scene: str, demo, obstacle: str, level: float, kind: str, penalty: float,
         comm: MPI.Comm, max_cuts: int = 2) -> dict:
     """One solve; times are the maximum over ranks."""
-    from dolfinx_mortar.contact.gaps import GlobalGap
     args = demo.parse_args(["--refine", repr(level), "--kind", kind, "--penalty", repr(penalty),
                             "--obstacle", obstacle])
     row = {"scene": scene, "obstacle": obstacle, "refine": level, "kind": kind,
@@ -104,13 +103,13 @@ def run(scene: str, demo, obstacle: str, level: float, kind: str, penalty: float
     row["dofs"] = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
     row["slave_nodes"] = problem.slave.layout.size_global
     times = setup_times(problem)
-    contact_setup = problem.timings_segmentation
+    contact_setup = problem.timings["contact_setup"]
     # The Newton matrix pattern is built once, on the first SNES setup; build
     # it here so that its residual evaluation does not land in the Newton times.
     t = time.perf_counter()
-    problem._total_matrix()
+    problem.problem.matrix()
     times["pattern"] = time.perf_counter() - t
-    problem.timings.clear()
+    problem.reset_timings()
     t = time.perf_counter()
     try:
         result = problem.solve(load_steps=args.load_steps, max_cuts=max_cuts)
@@ -119,8 +118,8 @@ def run(scene: str, demo, obstacle: str, level: float, kind: str, penalty: float
         return row
     solve = time.perf_counter() - t
     tm = problem.timings
-    factorization = (problem._augmented.factorization_time
-                     if isinstance(problem.gap_model, GlobalGap) else 0.0)
+    step = problem.contact.augmented_step
+    factorization = step.factorization_time if step is not None else 0.0
     callbacks = sum(tm.get(k, 0.0) for k in ("bulk_residual", "bulk_jacobian",
                                               "contact_residual", "contact_jacobian"))
     times["contact_assembly"] = (tm.get("contact_residual", 0.0)

@@ -130,7 +130,7 @@ def contact_results(problem, ref: dict) -> dict:
     near = (xq < 1.5 * ref["a"]) & (tab.points[..., 1] < 0.5 * problem_radius(problem))
     err2 = comm.allreduce(float(np.sum((tab.weights * (p_hat - exact) ** 2)[near])))
     ref2 = comm.allreduce(float(np.sum((tab.weights * exact ** 2)[near])))
-    total = problem.contact_force()
+    total = problem.normal_force()
     return {"p0": p0, "a": a_fit, "a_last_active_node": float(np.max(xs)),
             "l2_error": float(np.sqrt(err2 / ref2)), "contact_force": total,
             "active_nodes": int(len(xs))}
@@ -149,7 +149,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
     """
     from dolfinx import fem
     from dolfinx_mortar.contact.obstacles import RigidPlane
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     ref = hertz(args)
     domain, facet_tags, h_contact = build_mesh(args, ref["a"], comm)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", args.degree))

@@ -177,7 +177,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
     from dolfinx import fem
     import ufl
     from dolfinx_mortar.contact.obstacles import RigidPlane
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     E_star = args.E / (1 - args.nu ** 2)
     if args.mesh is None:
         factor = 2.0 if args.obstacle == "elastic" else 1.0  # E* halves for two bodies
@@ -223,7 +223,7 @@ def key_figures(args: argparse.Namespace, problem, result, context: dict,
                 wall: float) -> dict:
     """Errors against Hertz and the run's size and cost, on every rank."""
     comm = problem.mesh.comm
-    contact_force = context["quarter"] * problem.contact_force()
+    contact_force = context["quarter"] * problem.normal_force()
     force = args.force if args.load_displacement is None else contact_force
     figures = contact_results(problem, context["E_star"], args.radius, force)
     V = problem.V

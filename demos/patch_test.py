@@ -93,7 +93,7 @@ def build_mesh(dim: int, h_lower: float, h_upper: float, degree: int, comm: MPI.
 
 def run(args, orientation: str, kind: str, scaling: str, comm=MPI.COMM_WORLD) -> dict:
     from dolfinx import fem
-    from dolfinx_mortar.solver.problem import ContactProblem
+    from dolfinx_mortar import ContactProblem
     fine, coarse = args.fine, args.coarse
     # the slave is the lower block's top
     h_lower, h_upper = (fine, coarse) if orientation == "finer-slave" else (coarse, fine)

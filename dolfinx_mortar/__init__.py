@@ -30,6 +30,7 @@ from dolfinx_mortar.surfaces import lagrange, nurbs
 _LAZY = {
     "ContactTerm": "dolfinx_mortar.contact.term",
     "NonlinearContactProblem": "dolfinx_mortar.solver.nonlinear_problem",
+    "reaction_force": "dolfinx_mortar.solver.nonlinear_problem",
     "LoadPathSolver": "dolfinx_mortar.solver.load_path",
     "ContactProblem": "dolfinx_mortar.solver.elastic",
     "ContactDivergenceError": "dolfinx_mortar.solver.convergence",

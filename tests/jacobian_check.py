@@ -1,4 +1,5 @@
-"""Central differences of a ContactProblem's residual against its Jacobian."""
+"""Central differences of a problem's residual against its Jacobian (public API only:
+``problem.problem`` is the NonlinearContactProblem of a ContactProblem)."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,13 +10,13 @@ from mpi4py import MPI
 def jacobian_error(problem, rng_seed: int = 1) -> float:
     """‖(R(x + h dx) − R(x − h dx))/2h − J dx‖ / ‖J dx‖ at the current u."""
     x0 = problem.u.vector.copy()
-    J = problem._total_matrix()
-    b0 = problem.b.duplicate()
-    problem._residual(None, x0, b0)
-    problem._jacobian(None, x0, J, J)
+    J = problem.problem.matrix()
+    b0 = problem.problem.vector().duplicate()
+    problem.problem.F(x0, b0)
+    problem.problem.J(x0, J)
     # basis_configuration="current" gives the exact Jacobian once the active
     # set is the one of the previous call
-    problem._jacobian(None, x0, J, J)
+    problem.problem.J(x0, J)
     dx = x0.duplicate()
     dx.array[:] = np.random.default_rng(rng_seed + MPI.COMM_WORLD.rank).normal(
         size=dx.array.shape)
@@ -34,8 +35,8 @@ def residual_difference(problem, x0, direction, size: float = 1e-6):
     for sign in (1, -1):
         x = x0.copy()
         x.axpy(sign * h, direction)
-        b = problem.b.duplicate()
-        problem._residual(None, x, b)
+        b = problem.problem.vector().duplicate()
+        problem.problem.F(x, b)
         residuals.append(b)
     fd = residuals[0].copy()
     fd.axpy(-1.0, residuals[1])
@@ -46,10 +47,11 @@ def residual_difference(problem, x0, direction, size: float = 1e-6):
 def newton_history(start, problem, prefix: str) -> np.ndarray:
     """Residual norms of ``problem``'s Newton solve at full load, started from
     the solution of ``start`` (a problem on the same function space)."""
-    problem._set_load(1.0)
+    problem.set_load(1.0)
     start.u.vector.copy(problem.u.vector)
     problem.u.x.scatter_forward()
-    snes = problem._snes(prefix)
+    problem.solver.prefix = prefix
+    snes = problem.solver.create_snes()
     x = problem.u.vector.copy()
     snes.setConvergenceHistory(reset=True)
     snes.solve(None, x)

@@ -16,7 +16,7 @@ from mpi4py import MPI
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from meshes import rectangle  # noqa: E402
 from dolfinx_mortar.contact.obstacles import RigidPlane  # noqa: E402
-from dolfinx_mortar.solver.problem import ContactProblem  # noqa: E402
+from dolfinx_mortar import ContactProblem  # noqa: E402
 
 output, steps = sys.argv[1], int(sys.argv[2])
 domain, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (8, 4), bottom=1, top=2, left=3)

@@ -6,7 +6,7 @@ import pytest
 from dolfinx import fem
 from mpi4py import MPI
 
-from dolfinx_mortar.solver.problem import ContactProblem
+from dolfinx_mortar import ContactProblem
 from jacobian_check import jacobian_error
 
 GAP = 0.05
@@ -79,7 +79,7 @@ def test_separated_blocks_show_no_false_penetration_with_the_modification(kind):
 def test_modified_jacobian_matches_finite_differences():
     V, tags = overhanging_blocks()
     problem = _problem(V, tags, "LcLS*", True)
-    problem._set_load(1.0)
+    problem.set_load(1.0)
     # the upper block pushed into the lower one, with some tilt
     problem.u.interpolate(lambda x: np.vstack([0 * x[0], np.where(
         x[1] > GAP / 2, -0.06 - 0.01 * x[0], 0.0)]))
@@ -98,7 +98,7 @@ def test_modified_problem_closes_the_gap_and_presses():
                                     4: {1: -1.5 * GAP}})
     result = problem.solve(load_steps=2)
     assert len(result.steps) == 2
-    assert problem.contact_force() > 0
+    assert problem.normal_force() > 0
     n = problem.slave.layout.num_owned
     p = problem.nodal_pressures()[:n][problem.gap_model.covered[:n]]
     assert np.all(np.isfinite(p))

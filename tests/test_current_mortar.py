@@ -7,7 +7,7 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar.solver.problem import ContactProblem
+from dolfinx_mortar import ContactProblem
 from jacobian_check import convergence_order, jacobian_error, newton_history
 from test_finite_deformation import _energy_gradient_error
 from test_problem import LOCAL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks, load
@@ -28,7 +28,7 @@ def _sheared_blocks(kind: str, scaling: str = "consistent", degree: int = 1,
                              basis_configuration="current",
                              fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
                              tractions={demo.TOP: [0.0, -0.01]})
-    problem._set_load(1.0)
+    problem.set_load(1.0)
     tdim = domain.topology.dim
     cells = np.arange(domain.topology.index_map(tdim).size_local, dtype=np.int32)
     midpoints = mesh.compute_midpoints(domain, tdim, cells)[:, 1]
@@ -48,10 +48,10 @@ def test_differentiable_gaps_equal_the_kernels(kind, degree):
     if degree == 2 and kind in DUAL:
         pytest.skip("dual kinds need P1 lines in the current configuration (tested below)")
     problem = _sheared_blocks(kind, degree=degree)
-    state = problem._contact()
+    state = problem.contact.evaluate()
     model = problem.gap_model
     kernel = model.coupling.raw_pairs[2] @ model.C
-    jet = state.current.gap_data["value"]
+    jet = state.data.gap_data["value"]
     scale = problem.mesh.comm.allreduce(float(np.max(np.abs(kernel), initial=0.0)), op=MPI.MAX)
     error = problem.mesh.comm.allreduce(float(np.max(np.abs(kernel - jet), initial=0.0)),
                                         op=MPI.MAX)
@@ -193,7 +193,7 @@ def _sheared_boxes(kind: str, scaling: str = "consistent") -> ContactProblem:
                              fixed={demo.SYM_X: {0: 0.0}, demo.SYM_Y: {1: 0.0},
                                     demo.BOTTOM: {2: 0.0}},
                              tractions={demo.TOP: [0.0, 0.0, -0.01]})
-    problem._set_load(1.0)
+    problem.set_load(1.0)
     cells = np.arange(domain.topology.index_map(3).size_local, dtype=np.int32)
     height = mesh.compute_midpoints(domain, 3, cells)[:, 2]
     problem.u.interpolate(lambda x: np.vstack([0.01 * x[2] + 0.03 * x[0] ** 2,
@@ -213,12 +213,12 @@ def test_current_mortar_3d_is_the_kernel_and_its_exact_derivatives(kind, scaling
     """P1 triangles: clipping in Jet arithmetic equals the kernel; the residual is
     ∂Π/∂u and the Jacobian its Hessian."""
     problem = _sheared_boxes(kind, scaling)
-    state = problem._contact()
+    state = problem.contact.evaluate()
     model = problem.gap_model
     kernel = model.coupling.raw_pairs[2] @ model.C
     comm = problem.mesh.comm
     scale = comm.allreduce(float(np.max(np.abs(kernel), initial=0.0)), op=MPI.MAX)
-    error = comm.allreduce(float(np.max(np.abs(kernel - state.current.gap_data["value"]),
+    error = comm.allreduce(float(np.max(np.abs(kernel - state.data.gap_data["value"]),
                                         initial=0.0)), op=MPI.MAX)
     assert scale > 0 and error < 1e-12 * scale
     n = problem.slave.layout.num_owned

@@ -87,7 +87,7 @@ def test_weights_and_mass_match_dolfinx_facet_forms(case):
     r.array[:] = np.random.default_rng(domain.comm.rank).uniform(size=n)
     y_dolfinx, y_mortar = L.createVecLeft(), L.createVecLeft()
     L.mult(r, y_dolfinx)
-    b._solver.matrix.mult(r, y_mortar)
+    b.mass_solver.matrix.mult(r, y_mortar)
     on_surface = W.array > 0
     assert np.allclose(y_mortar.array[on_surface], y_dolfinx.array[on_surface],
                        rtol=0, atol=1e-14)

@@ -20,7 +20,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.obstacles import RigidPlane
-from dolfinx_mortar.solver.problem import ContactProblem
+from dolfinx_mortar import ContactProblem
 from dolfinx_mortar.io.surface_output import surface_output_path
 from test_problem import block_on_plane
 

@@ -8,7 +8,7 @@ from mpi4py import MPI
 
 from dolfinx_mortar.contact.cut_quadrature import positive_part_rule
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
-from dolfinx_mortar.solver.problem import ContactDivergenceError, ContactProblem
+from dolfinx_mortar import ContactDivergenceError, ContactProblem
 from jacobian_check import jacobian_error
 from test_problem import ALL_KINDS, block_on_plane, load, pressed_block
 
@@ -50,7 +50,7 @@ def test_pointwise_jacobian_matches_finite_differences_on_cut_cells(kind, obstac
           else RigidSphere([0.5, -2.0], 2.0))
     problem = pressed_block(ob, kind, active_set="pointwise")
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[1], -0.0031 + 0.003 * x[0] ** 2]))
-    state = problem._contact()
+    state = problem.contact.evaluate()
     n = problem.slave.layout.num_owned
     positive = problem.mesh.comm.allreduce(int(np.sum(state.gaps_plus[:n] > 0)))
     negative = problem.mesh.comm.allreduce(int(np.sum(state.gaps[:n] < 0)))
@@ -66,14 +66,14 @@ def test_pointwise_jacobian_matches_finite_differences_elastic_master():
                              nu=0.3, kind="LmLS*", penalty=1e3, active_set="pointwise",
                              fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
                              tractions={demo.TOP: [0.0, -0.01]})
-    problem._set_load(1.0)
+    problem.set_load(1.0)
     # the upper block tilted into the lower one: contact on part of the interface
     tdim = domain.topology.dim
     cells = np.arange(domain.topology.index_map(tdim).size_local, dtype=np.int32)
     upper = cells[mesh.compute_midpoints(domain, tdim, cells)[:, 1] > 0]
     problem.u.interpolate(lambda x: np.vstack([0 * x[0], -0.002 * (x[0] - 0.4)]), cells=upper)
     problem.u.x.scatter_forward()
-    state = problem._contact()
+    state = problem.contact.evaluate()
     n = problem.slave.layout.num_owned
     assert problem.mesh.comm.allreduce(int(np.sum(state.gaps_plus[:n] > 0))) > 0
     assert problem.mesh.comm.allreduce(int(np.sum(state.gaps[:n] < 0))) > 0

@@ -11,7 +11,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
-from dolfinx_mortar.solver.problem import ContactDivergenceError, ContactProblem
+from dolfinx_mortar import ContactDivergenceError, ContactProblem
 from jacobian_check import residual_difference
 from meshes import rectangle
 
@@ -126,7 +126,7 @@ def pressed_block(obstacle, kind: str, n=(6, 3), **options) -> ContactProblem:
     problem = ContactProblem(V, tags, 1, obstacle=obstacle, E=1.0, nu=0.3, kind=kind,
                              penalty=50.0, fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]},
                              **options)
-    problem._set_load(1.0)
+    problem.set_load(1.0)
     return problem
 
 
@@ -138,10 +138,10 @@ def test_jacobian_matches_finite_differences(kind, obstacle):
     problem = pressed_block(ob, kind)
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[1], -0.002 + 0.003 * x[0] ** 2]))
     x0 = problem.u.vector.copy()
-    J = problem._total_matrix()
-    b0 = problem.b.duplicate()
-    problem._residual(None, x0, b0)
-    problem._jacobian(None, x0, J, J)
+    J = problem.problem.matrix()
+    b0 = problem.problem.vector().duplicate()
+    problem.problem.F(x0, b0)
+    problem.problem.J(x0, J)
     assert problem.mesh.comm.allreduce(int(np.sum(problem.nodal_gaps() > 0))) > 0
     dx = x0.duplicate()
     dx.array[:] = np.random.default_rng(1).normal(size=dx.array.shape) * 1e-3
@@ -152,7 +152,7 @@ def test_jacobian_matches_finite_differences(kind, obstacle):
     x1 = x0.copy()
     x1.axpy(h, dx)
     b1 = b0.duplicate()
-    problem._residual(None, x1, b1)
+    problem.problem.F(x1, b1)
     fd = b1.copy()
     fd.axpy(-1.0, b0)
     fd.scale(1 / h)
@@ -264,7 +264,7 @@ def test_a_huge_penalty_is_balanced_or_refused():
         assert "Newton step at round-off" in str(err) and "reference force" in str(err)
         return
     # the vertical load is carried by the normal contact force alone
-    balance = problem.contact_force() * normal[1] / np.linalg.norm(normal) / 0.01 - 1
+    balance = problem.normal_force() * normal[1] / np.linalg.norm(normal) / 0.01 - 1
     assert abs(balance) < 1e-6
 
 
@@ -325,7 +325,7 @@ def test_mortar_traction_on_the_slave_surface_mesh(kind, tmp_path_factory):
     assert np.allclose(f.x.array[out.dofs], p_star[out.source])
     tab = slave.tabulate(4, transformed=False)
     total = comm.allreduce(float(np.einsum("cq,cqb,cb->", tab.weights, tab.phi, p_star)))
-    assert total == pytest.approx(problem.contact_force(), rel=1e-10)
+    assert total == pytest.approx(problem.normal_force(), rel=1e-10)
 
 
 def test_bad_input_is_reported():
@@ -409,14 +409,13 @@ def test_gls_newton_step_inverts_the_residual_derivative(kind, active_set):
     problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -2.0], 2.0), E=1.0,
                              nu=0.3, kind=kind, penalty=50.0, fixed={3: {0: 0.0}},
                              tractions={2: [0.0, -0.01]}, active_set=active_set)
-    problem._set_load(1.0)
+    problem.set_load(1.0)
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[1], -0.0031 + 0.003 * x[0] ** 2]))
-    snes = problem._snes("gls_step_test_")
     x0 = problem.u.vector.copy()
-    b0 = problem.b.duplicate()
-    problem._residual(None, x0, b0)
-    J = problem._total_matrix()
-    problem._jacobian(None, x0, J, J)
+    b0 = problem.problem.vector().duplicate()
+    problem.problem.F(x0, b0)
+    J = problem.problem.matrix()
+    problem.problem.J(x0, J)
     gaps = problem.nodal_gaps()
     n = problem.slave.layout.num_owned
     assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) > 0
@@ -425,11 +424,14 @@ def test_gls_newton_step_inverts_the_residual_derivative(kind, active_set):
     r.array[:] = np.random.default_rng(2 + MPI.COMM_WORLD.rank).normal(size=r.array.shape)
     fem.petsc.set_bc(r, problem.bcs, scale=0.0)
     du = r.duplicate()
-    problem._augmented.apply(None, r, du)
+    ksp = PETSc.KSP().create(problem.mesh.comm)
+    ksp.setOperators(J)
+    problem.problem.configure_ksp(ksp)    # the exact step of the augmented system
+    ksp.solve(r, du)
     fd = residual_difference(problem, x0, du)
     fd.axpy(-1.0, r)
     assert fd.norm() < 1e-6 * r.norm()
-    snes.destroy()
+    ksp.destroy()
 
 
 def test_previous_configuration_resegments_and_still_passes_the_patch_test():
@@ -501,7 +503,7 @@ def test_hertz3d_two_elastic_bodies_from_a_mesh_file(tmp_path_factory):
 def test_first_touch_with_positive_mortar_functions_converges():
     """A sphere touching a plane at one point with LmLS*: every d̄_A < 0 at the start.
 
-    Without the gap-closing start (ContactProblem._close_gaps) Newton crept
+    Without the gap-closing start (LoadPathSolver.close_gaps) Newton crept
     towards the plane by F/(εA) per iteration and failed after every cut-back.
     """
     figures = load("hertz3d").main(["--kind", "LmLS*", "--refine", "0.7"])
@@ -521,14 +523,14 @@ def test_gls_first_touch_starts_from_the_closed_gap(kind):
                              nu=0.3, kind=kind, penalty=1e4, fixed={3: {0: 0.0}},
                              tractions={2: [0.0, -0.01]})
     attempts = []
-    newton = problem._newton
+    newton = problem.solver.newton_step
 
     def counted(snes, x):
         outcome = newton(snes, x)
         attempts.append(outcome[2])
         return outcome
-    problem._newton = counted
+    problem.solver.newton_step = counted
     result = problem.solve(load_steps=2)
     assert result.steps[0].load_factor == 0.5 and result.steps[0].newton_iterations <= 6
-    assert result.steps[-1].load_factor == 1.0 and problem.contact_force() > 0
+    assert result.steps[-1].load_factor == 1.0 and problem.normal_force() > 0
     assert max(attempts) <= 15, attempts   # cycles of period 2 and 3 ran to 40

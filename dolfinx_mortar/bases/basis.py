@@ -82,9 +82,9 @@ class MortarBasis:
                 self.coefficients = None
                 mass = self.layout.assemble_matrix(self.cells, self.element_mass)
                 mass.setOption(mass.Option.SYMMETRIC, True)
-                self._solver: Optional[MassMatrixSolver] = MassMatrixSolver(self.layout, mass)
+                self.mass_solver: Optional[MassMatrixSolver] = MassMatrixSolver(self.layout, mass)
             else:
-                self._solver = None
+                self.mass_solver = None
                 dual = self.kind in (BasisKind.LcLS_star, BasisKind.LcLS)
                 mass = self.element_mass if dual else np.zeros((0, 0, 0))
                 self.coefficients = _kernels.basis_coefficients(
@@ -123,10 +123,10 @@ class MortarBasis:
     def nodal_values(self, f: FieldLike) -> FloatArray:
         """``f_A = ∫ M_A f dA`` at the owned and ghost functions of this rank."""
         g = self.element_integrals(f)
-        if self._solver is None:
+        if self.mass_solver is None:
             contributions = np.einsum("cba,cb->ca", self.coefficients, g)
             return self.layout.sum_at_functions(self.cells, contributions)
-        x = self._solver.solve(self.layout.sum_at_functions(self.cells, g))
+        x = self.mass_solver.solve(self.layout.sum_at_functions(self.cells, g))
         return x * self.lumped_weights if self.kind == BasisKind.GLS_star else x
 
     # -- fields on the surface ---------------------------------------------------
@@ -137,10 +137,10 @@ class MortarBasis:
         Discontinuous across elements for the dual kinds.
         """
         nodal = np.asarray(nodal, dtype=np.float64)
-        if self._solver is None:
+        if self.mass_solver is None:
             return np.einsum("cba,ca->cb", self.coefficients, nodal[self.cells])
         rhs = nodal * self.lumped_weights if self.kind == BasisKind.GLS_star else nodal
-        return self._solver.solve(rhs)[self.cells]
+        return self.mass_solver.solve(rhs)[self.cells]
 
     def evaluate(self, cells: npt.ArrayLike, phi: FloatArray) -> FloatArray:
         """All ``M_A`` at points, given their cells and slave basis values there.
@@ -153,7 +153,7 @@ class MortarBasis:
         n = self.layout.size_local
         out = np.zeros((len(cells), n))
         rows = np.repeat(np.arange(len(cells)), self.cells.shape[1])
-        if self._solver is None:
+        if self.mass_solver is None:
             values = np.einsum("rb,rba->ra", phi, self.coefficients[cells])
             np.add.at(out, (rows, self.cells[cells].ravel()), values.ravel())
             return out
@@ -162,7 +162,7 @@ class MortarBasis:
                 f"dense evaluation of the global kind {kind_name(self.kind)} needs the whole "
                 "surface on one rank; use mortar_coefficients() in parallel")
         np.add.at(out, (rows, self.cells[cells].ravel()), phi.ravel())
-        M = np.array([self._solver.solve(row) for row in out])  # M = N L⁻¹ (L = Lᵀ)
+        M = np.array([self.mass_solver.solve(row) for row in out])  # M = N L⁻¹ (L = Lᵀ)
         return M * self.lumped_weights[None, :] if self.kind == BasisKind.GLS_star else M
 
 

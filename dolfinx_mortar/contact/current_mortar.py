@@ -30,7 +30,7 @@ from dolfinx_mortar.contact.jet import Jet, dot, maximum, minimum
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
-from dolfinx_mortar.mortar.coupling import (MortarCoupling, _polynomial_degree, _segment_quadrature,
+from dolfinx_mortar.mortar.coupling import (MortarCoupling, polynomial_degree, segment_quadrature,
                                    gather_surface)
 
 FloatArray = npt.NDArray[np.float64]
@@ -121,6 +121,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
         again at every evaluation).
     """
 
+    moving_pattern = True
+
     def __init__(self, slave: LagrangeSurface, master: LagrangeSurface, kind: KindLike,
                  penalty: float, scaling: str = "consistent",
                  search_radius: Optional[float] = None):
@@ -135,9 +137,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
         self.master, self.search_radius = master, search_radius
         self.slave_degree = slave.reference.degree
         self.master_degree = master.reference.degree
-        degree = _polynomial_degree(slave) + max(_polynomial_degree(slave),
-                                                 _polynomial_degree(master))
-        self.segment_points, self.segment_weights = _segment_quadrature(slave.tdim, degree)
+        degree = polynomial_degree(slave) + max(polynomial_degree(slave),
+                                                 polynomial_degree(master))
+        self.segment_points, self.segment_weights = segment_quadrature(slave.tdim, degree)
         if slave.gdim == 2:
             self._neighbours = self._normal_neighbours()
         else:

@@ -24,13 +24,16 @@ master. GLS/GLS* (L depends on u through every facet) are not covered.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 import basix
 import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.gaps import _GapBase
+from dolfinx_mortar.contact.gaps import GapModelBase
+from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, is_partition_of_unity, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
@@ -81,7 +84,7 @@ class CurrentState:
     gap_data: object         #: what the gap's source needs for Σ_A F_g,A ∂²ĝ_A
 
 
-class CurrentSurfaceGap(_GapBase):
+class CurrentSurfaceGap(GapModelBase):
     """Penalty contact with the bases on the current slave surface (base class).
 
     Subclasses give ``ĝ_A = ∫ φ_A d da`` and its derivatives
@@ -132,7 +135,7 @@ class CurrentSurfaceGap(_GapBase):
         nc, nd = cells.shape
         #: local and global dofs of every slave cell's nodes, (cells, nd·gdim)
         self.cell_dofs_local = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, nd * gdim)
-        self.cell_dofs = self._node_dofs(cells).reshape(nc, nd * gdim)
+        self.cell_dofs = self.node_dofs(cells).reshape(nc, nd * gdim)
 
     # -- what a gap source provides ------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, object]:
@@ -175,7 +178,14 @@ class CurrentSurfaceGap(_GapBase):
         return self.slave.layout.sum_at_functions(
             self.slave.cells, np.einsum("cq,qa->ca", self.wq[None, :] * e["J"], self.N))
 
-    def evaluate(self, u_nodes: FloatArray, mask: PETSc.Vec) -> CurrentState:
+    def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
+        """The contact state at the displacement Function ``u``
+        (:class:`CurrentState` in ``data``)."""
+        current = self.evaluate_nodes(nodal_displacement(self.slave, u), mask)
+        return ContactState(current.y, current.G_y, self.weights * np.maximum(current.y, 0.0),
+                            current.residual, data=current)
+
+    def evaluate_nodes(self, u_nodes: FloatArray, mask: Optional[PETSc.Vec]) -> CurrentState:
         """Nodal gaps, their derivatives and the residual at ``u_nodes`` (local nodes).
 
         ``mask``: 1 on free dofs, 0 on Dirichlet dofs (columns to drop).
@@ -189,8 +199,9 @@ class CurrentSurfaceGap(_GapBase):
         dW_c = np.einsum("q,qa,cqbi->cabi", self.wq, self.N, e["dJ"])
         G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
                               dW_c.reshape(nc, nd, nd * gdim))
-        G_g.diagonalScale(None, mask)
-        G_W.diagonalScale(None, mask)
+        if mask is not None:
+            G_g.diagonalScale(None, mask)
+            G_W.diagonalScale(None, mask)
         y, Fg, FW, _, _, _ = self._nodal_coefficients(g, W, np.zeros_like(g))
         residual = G_g.createVecRight()
         tmp = G_W.createVecRight()
@@ -212,14 +223,15 @@ class CurrentSurfaceGap(_GapBase):
             Wsafe[cells] ** (-self.k))[:, None, :]
         return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, e, gap_data)
 
-    def jacobian(self, state: CurrentState, active: FloatArray, mask: PETSc.Vec,
+    def jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
                  geometric: bool = True) -> PETSc.Mat:
         """∂²Π/∂u² with ``active`` (0/1 per node) as the generalized H(y).
 
         ``geometric=False`` keeps only ``G_yᵀ diag(ωH) G_y``, the part that a
         frozen surface would give: positive semi-definite, for the iterations
-        in which the active set still moves (see ContactProblem._jacobian).
+        in which the active set still moves (see ContactTerm.assemble_jacobian).
         """
+        state = state.data
         layout = self.slave.layout
         if not geometric:
             right = state.G_y.copy()
@@ -249,8 +261,9 @@ class CurrentSurfaceGap(_GapBase):
         K_el = assemble_blocks(self.dofs, self.cell_dofs_local, self.dofs, self.cell_dofs,
                                blocks.reshape(nc, width, width))
         K_el.axpy(1.0, self._gap_hessian(state.gap_data, state.Fg), structure=Different)
-        K_el.diagonalScale(mask, mask)
-        K.diagonalScale(mask, mask)
+        if mask is not None:
+            K_el.diagonalScale(mask, mask)
+            K.diagonalScale(mask, mask)
         K.axpy(1.0, K_el, structure=Different)
         return K
 
@@ -270,7 +283,7 @@ class CurrentSurfaceGap(_GapBase):
         """W_A on the surface of the last evaluation (the reference one before)."""
         return getattr(self, "_current_weights", self.basis.lumped_weights)
 
-    def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
+    def pressures_from_gaps(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """``p_A`` in the PU basis on the current surface (see ObstacleGap)."""
         W = self.lumped_weights
         force = self.penalty * np.where(W > 0, W, 1.0) ** self.m * np.maximum(gaps, 0.0)

@@ -14,9 +14,12 @@ exact for the nodal active set (semi-smooth Newton). The scalings:
   problem;
 - ``"seed"``: ``d_A = ∫ M_A d`` with the kind itself and ``ω_A = ε``.
 
-Two gap models: :class:`ObstacleGap` (rigid analytic obstacle, exact and
-nonlinear in u) and :class:`MortarGap` (elastic master, small deformation:
-segmented once, linear in u).
+Two gap models with bases frozen in one configuration: :class:`ObstacleGap`
+(rigid analytic obstacle, exact and nonlinear in u) and :class:`MortarGap`
+(elastic master, segmented once, linear in u). Both implement
+:class:`~dolfinx_mortar.contact.state.GapModel`; so do
+:class:`~dolfinx_mortar.contact.global_gap.GlobalGap` (GLS kinds) and the
+current-configuration models.
 """
 from __future__ import annotations
 
@@ -27,12 +30,15 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.bases.basis import MortarBasis
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import (BasisKind, KindLike, is_global, is_partition_of_unity,
                                   parse_kind, unstarred_partner)
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import MassMatrixSolver, NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle
+from dolfinx_mortar.contact.pointwise import MortarPointGaps, obstacle_positive_gaps
+from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -59,8 +65,17 @@ def dof_layout(nodes: NodeLayout, bs: int) -> NodeLayout:
     return NodeLayout(nodes.comm, nodes.num_owned * bs, ghosts)
 
 
-class _GapBase:
-    """Shared state: the slave surface, the gap basis and the node weights ω."""
+class GapModelBase:
+    """Shared state: the slave surface, the gap basis and the node weights ω,
+    and what the models with frozen bases share of
+    :class:`~dolfinx_mortar.contact.state.GapModel`."""
+
+    augmented = False
+    moving_pattern = False
+    #: the pointwise active set (d̄⁺ = ∫M̄⟨d⟩) instead of the nodal one
+    pointwise = False
+    #: the segmentation against an elastic master (None against an obstacle)
+    coupling = None
 
     def __init__(self, slave: LagrangeSurface, kind: KindLike, penalty: float,
                  scaling: str):
@@ -86,7 +101,19 @@ class _GapBase:
         covered part with the boundary modification)."""
         return getattr(self, "_weights_source", self.basis.lumped_weights)
 
-    def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
+    def nodal_pressures(self, state: ContactState) -> FloatArray:
+        """``p_A = ε⟨d̄_A⟩`` (nodal active set) or ``ε d̄⁺_A`` (pointwise),
+        consistent scaling (:meth:`pressures_from_gaps`)."""
+        if state.gaps_plus is not None:
+            return self.pressures_from_gaps(state.gaps_plus, positive_part=False)
+        return self.pressures_from_gaps(state.gaps)
+
+    def mortar_traction(self, state: ContactState) -> FloatArray:
+        """``p* = Σ_A f_A M_A`` at the nodes of every slave cell, (cells, nodes)."""
+        # M_A at node b of cell c is C[c, b, A]: N_std is 1 at its own node
+        return np.einsum("cba,ca->cb", self.coefficients_std, state.force[self.slave.cells])
+
+    def pressures_from_gaps(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """Pressure coefficients ``p_A`` of the contact traction in a PU basis.
 
         The traction is ``Σ_A ω_A ⟨d_A⟩ M_A`` with ``M`` the gap basis. A non-PU
@@ -102,14 +129,60 @@ class _GapBase:
         W = self.lumped_weights
         return np.divide(force, W, out=np.zeros_like(W), where=W > 0)
 
-    def _node_dofs(self, nodes: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
+    def state(self, gaps: FloatArray, G: PETSc.Mat, force: FloatArray,
+              mask: Optional[PETSc.Vec], gaps_plus: Optional[FloatArray] = None,
+              G_plus: Optional[PETSc.Mat] = None,
+              K_curv: Optional[PETSc.Mat] = None) -> ContactState:
+        """The state from the gaps, their derivative and the nodal force:
+        Dirichlet columns dropped, residual ``Gᵀ force``."""
+        if mask is not None:
+            G.diagonalScale(None, mask)
+            if G_plus is not None:
+                G_plus.diagonalScale(None, mask)
+            if K_curv is not None:
+                K_curv.diagonalScale(mask, mask)
+        residual = G.createVecRight()
+        G.multTranspose(self.slave.layout.vector(force), residual)
+        return ContactState(gaps, G, force, residual, K_curv, gaps_plus, G_plus)
+
+    def jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
+                 geometric: bool = True) -> PETSc.Mat:
+        """``Gᵀ diag(ωH) G`` (+ curvature); pointwise: ``Gᵀ diag(ω) G⁺``.
+
+        With the pointwise set and no penetration anywhere G⁺ = 0: the nodal
+        form with ``active`` stiffens the touching nodes instead.
+        """
+        G_right, weights = state.G, self.weights * active
+        if state.gaps_plus is not None and self.any_penetration(state.gaps_plus):
+            G_right, weights = state.G_plus, self.weights
+        SG = G_right.copy()
+        SG.diagonalScale(self.slave.layout.vector(weights), None)
+        K = state.G.transposeMatMult(SG)
+        if state.K_curv is not None:
+            K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        return K
+
+    def pattern(self, state: ContactState, mask: Optional[PETSc.Vec]) -> PETSc.Mat:
+        """A matrix with every entry the contact stiffness may have."""
+        return self.jacobian(state, np.ones_like(self.weights), mask)
+
+    def nodal_force(self, values: FloatArray) -> FloatArray:
+        """The nodal force f of ``R_c = Gᵀ f`` for nodal values ω⟨d̄⟩ (here: themselves)."""
+        return values
+
+    def any_penetration(self, gaps_plus: FloatArray) -> bool:
+        """Whether d̄⁺ ≠ 0 anywhere: else G⁺ = 0 and the nodal form stiffens."""
+        n = self.slave.layout.num_owned
+        return bool(self.slave.layout.comm.allreduce(bool(np.any(gaps_plus[:n] != 0))))
+
+    def node_dofs(self, nodes: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
         """Global dofs (node·bs + k) of local nodes, shape nodes.shape + (bs,)."""
         g = self.slave.layout.global_indices[nodes]
         bs = self.slave.gdim
         return g[..., None] * bs + np.arange(bs)
 
 
-class ObstacleGap(_GapBase):
+class ObstacleGap(GapModelBase):
     """Nodal gaps against a rigid analytic obstacle: ``d = −φ(x + u)``.
 
     Exact in u (no segmentation: the obstacle lies below every slave point).
@@ -118,8 +191,9 @@ class ObstacleGap(_GapBase):
     def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: KindLike,
                  penalty: float, scaling: str = "consistent",
                  quadrature_degree: Optional[int] = None,
-                 reference: Optional[FloatArray] = None):
+                 reference: Optional[FloatArray] = None, pointwise: bool = False):
         super().__init__(slave, kind, penalty, scaling)
+        self.pointwise = pointwise
         #: nodal displacement that moved ``slave`` to its configuration (or None)
         self.reference = reference
         if obstacle.gdim != slave.gdim:
@@ -133,7 +207,35 @@ class ObstacleGap(_GapBase):
         #: slave nodes with something below them (here: all; the obstacle is unbounded)
         self.covered = slave.layout.on_cells(slave.cells)
 
-    def evaluate(self, u_nodes: FloatArray) -> tuple[FloatArray, PETSc.Mat, FloatArray]:
+    def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
+        """The contact state at the displacement Function ``u``."""
+        gaps, G, x, gaps_plus, G_plus = self.raw_gaps(u)
+        force = self.weights * (gaps_plus if self.pointwise else np.maximum(gaps, 0.0))
+        return self.state(gaps, G, force, mask, gaps_plus, G_plus, self.curvature(force, x))
+
+    def raw_gaps(self, u):
+        """Nodal gaps, G, the current quadrature points, and (pointwise) d̄⁺, G⁺,
+        at the displacement Function ``u``."""
+        u_nodes = nodal_displacement(self.slave, u)
+        gaps, G, x = self.nodal_gaps(u_nodes)
+        gaps_plus = G_plus = None
+        if self.pointwise:
+            gaps_plus, G_plus = obstacle_positive_gaps(self, u_nodes, x)
+        return gaps, G, x, gaps_plus, G_plus
+
+    def curvature(self, force: FloatArray, x: FloatArray) -> Optional[PETSc.Mat]:
+        """``Σ_A f_A ∂²d̄_A/∂u²`` (None for a flat obstacle)."""
+        blocks = self.curvature_blocks(force, x)
+        if blocks is None:
+            return None
+        cells, gdim = self.slave.cells, self.slave.gdim
+        nc, nd = cells.shape
+        width = nd * gdim
+        dofs = self.node_dofs(cells).reshape(nc, width)
+        local = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, width)
+        return assemble_blocks(self.dofs, local, self.dofs, dofs, blocks)
+
+    def nodal_gaps(self, u_nodes: FloatArray) -> tuple[FloatArray, PETSc.Mat, FloatArray]:
         """Nodal gaps, G, and the obstacle Hessian data at the quadrature points.
 
         ``u_nodes``: displacement at the local slave-layout nodes, (nodes, gdim).
@@ -151,7 +253,7 @@ class ObstacleGap(_GapBase):
         # ∂d̄_A/∂u_(B,k) = −Σ_q w M̄_A ν_k N_B
         blocks = -np.einsum("cq,cqa,cqk,cqb->cabk", tab.weights, self.Mbar, nu, tab.phi)
         G = assemble_blocks(self.slave.layout, cells, self.dofs,
-                            self._node_dofs(cells).reshape(nc, nd * self.slave.gdim),
+                            self.node_dofs(cells).reshape(nc, nd * self.slave.gdim),
                             blocks.reshape(nc, nd, nd * self.slave.gdim))
         return gaps, G, x
 
@@ -169,7 +271,7 @@ class ObstacleGap(_GapBase):
         return blocks.reshape(nc, nd * gdim, nd * gdim)
 
 
-class MortarGap(_GapBase):
+class MortarGap(GapModelBase):
     """Nodal gaps against an elastic master in the same mesh, small deformation.
 
     Segmented once, in the configuration of ``reference`` (the displacement
@@ -181,6 +283,7 @@ class MortarGap(_GapBase):
                  scaling: str = "consistent", reference: Optional[PETSc.Vec] = None,
                  boundary_modification: bool = False):
         self.reference = reference
+        self.pointwise = coupling.points is not None
         super().__init__(coupling.slave, kind, penalty, scaling)
         if coupling.master.layout is not coupling.slave.layout and (
                 coupling.master.layout.size_global != coupling.slave.layout.size_global):
@@ -191,7 +294,7 @@ class MortarGap(_GapBase):
         if boundary_modification:
             # dual basis rebuilt over the covered part of every covered cell
             # (Popp et al. 2013); its ∫_cov M̄_A = 1 pairs it with W_cov
-            C = coupling._covered_coefficients(self.basis.kind)
+            C = coupling.covered_coefficients(self.basis.kind)
             T = self.slave.reference.transform
             self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
             _, _, W_cov = coupling.covered_element_mass()
@@ -210,7 +313,7 @@ class MortarGap(_GapBase):
         n = coupling.normals[slave_cells]                      # (pairs, ns, gdim)
         master_nodes = coupling.master_global_ids[coupling.master_cells[coupling.pairs[:, 1]]]
         bs = self.slave.gdim
-        slave_dofs = self._node_dofs(slave_cells)              # (pairs, ns, bs)
+        slave_dofs = self.node_dofs(slave_cells)              # (pairs, ns, bs)
         master_dofs = master_nodes[..., None] * bs + np.arange(bs)
         blocks = np.concatenate([np.einsum("pab,pak->pabk", Dg, n),
                                  -np.einsum("pac,pak->pack", Mg, n)], axis=2)
@@ -222,11 +325,25 @@ class MortarGap(_GapBase):
                                  blocks.reshape(npairs, ns, width))
         #: the segment points for the pointwise active set (None: nodal only)
         self.points = None
-        if coupling.points is not None:
-            from dolfinx_mortar.contact.pointwise import MortarPointGaps
+        if self.pointwise:
             self.points = MortarPointGaps(self)
 
-    def evaluate(self, u: PETSc.Vec) -> FloatArray:
+    def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
+        """The contact state at the displacement Function ``u``."""
+        gaps, G, _, gaps_plus, G_plus = self.raw_gaps(u)
+        force = self.weights * (gaps_plus if self.pointwise else np.maximum(gaps, 0.0))
+        return self.state(gaps, G, force, mask, gaps_plus, G_plus)
+
+    def raw_gaps(self, u):
+        """Nodal gaps, G (a copy), None (no curvature), and (pointwise) d̄⁺, G⁺."""
+        u.x.scatter_forward()
+        gaps = self.nodal_gaps(u.vector)
+        gaps_plus = G_plus = None
+        if self.pointwise:
+            gaps_plus, G_plus = self.points.positive_gaps(u.vector)
+        return gaps, self.G.copy(), None, gaps_plus, G_plus
+
+    def nodal_gaps(self, u: PETSc.Vec) -> FloatArray:
         """Nodal gaps at the local slave nodes for the displacement vector ``u``."""
         if self.reference is not None:
             u = u.copy()
@@ -234,60 +351,3 @@ class MortarGap(_GapBase):
         Gu = self.G.createVecLeft()
         self.G.mult(u, Gu)
         return self.gaps0 + self.slave.layout.to_local(Gu)
-
-
-def covered_mass(coupling: MortarCoupling) -> tuple[MassMatrixSolver, FloatArray]:
-    """``L_AB = ∫_cov N_A N_B`` over the covered slave area, factorized, and its
-    row sums ``W_A = ∫_cov N_A``. Nodes with no covered support get a unit row
-    (their gap is 0 and their weight 0)."""
-    slave = coupling.slave
-    L, covered_cells, W = coupling.covered_element_mass()
-    matrix = slave.layout.assemble_matrix(slave.cells[covered_cells], L[covered_cells])
-    return MassMatrixSolver(slave.layout, matrix), W
-
-
-class GlobalGap:
-    """Nodal gaps of GLS and GLS*: ``d̄ = L⁻¹ ĝ(u)`` with ``ĝ_B = ∫ N_B d``.
-
-    ``M_A`` has global support, so ``G = L⁻¹ Ĝ`` is dense; only the sparse
-    ``Ĝ = ∂ĝ/∂u`` and ``L`` are assembled, and the Newton step solves the
-    augmented system of DESIGN.md §3 (see :class:`AugmentedNewtonStep`).
-    ``inner`` computes ``ĝ`` and ``Ĝ`` (a standard-basis gap model).
-    """
-
-    def __init__(self, inner, kind: KindLike, penalty: float, scaling: str):
-        self.inner = inner
-        self.kind = parse_kind(kind)
-        self.scaling = scaling
-        self.slave = inner.slave
-        self.basis = MortarBasis(BasisKind.GLS, self.slave)
-        if isinstance(inner, MortarGap):
-            # The projection d̄ = L⁻¹ĝ must see d only where it exists: with L
-            # over the whole surface, the uncovered part counts as d = 0 and
-            # the gaps ring past the covered zone (a node beyond it got
-            # d̄ = +0.31 h on two touching cylinders at zero load).
-            self.mass, W = covered_mass(inner.coupling)
-        else:
-            self.mass, W = self.basis._solver, self.basis.lumped_weights
-        #: W_A = ∫ N_A over the part that enters the projection
-        self.lumped_weights = W
-        # Π_c = Σ (ω_A/2)⟨d̄_A⟩² in terms of the GLS gap d̄ (∫M_A = 1):
-        # consistent ω = εW; seed GLS ω = ε; seed GLS* (d_A = W_A d̄_A) ω = εW².
-        if scaling == "consistent":
-            self.weights = penalty * W
-        elif self.kind == BasisKind.GLS:
-            self.weights = penalty * np.ones_like(W)
-        else:
-            self.weights = penalty * W ** 2
-        self.dofs = inner.dofs
-        self.covered = inner.covered
-        #: owned local nodes of the slave surface (the rows the Newton step needs)
-        owned = np.unique(self.slave.cells)
-        self.surface_rows = owned[owned < self.slave.layout.num_owned]
-        self.weights = np.where(self.covered, self.weights, 0.0)
-
-    def nodal_pressures(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
-        """``p_A = ω_A⟨d̄_A⟩/W_A`` (coefficients of the traction in the PU basis GLS*)."""
-        W = self.lumped_weights
-        force = self.weights * (np.maximum(gaps, 0.0) if positive_part else gaps)
-        return np.divide(force, W, out=np.zeros_like(W), where=W > 0)

@@ -3,6 +3,10 @@
 An obstacle is its signed distance φ (positive outside the obstacle), with the
 gradient and Hessian the exact contact Jacobian needs. The penetration of a
 slave point x is d = −φ(x).
+
+Obstacles move rigidly along a load path: ``obstacle.move_to(d)`` places it at
+its initial position plus the translation ``d`` (for example from the
+load-path callback of :class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`).
 """
 from __future__ import annotations
 
@@ -18,6 +22,8 @@ class RigidObstacle(Protocol):
     """What the contact terms need of a rigid obstacle. ``x`` has shape (n, gdim)."""
 
     gdim: int
+    #: the translation from the initial position (gdim,)
+    displacement: FloatArray
 
     def signed_distance(self, x: FloatArray) -> FloatArray: ...
 
@@ -33,7 +39,25 @@ def _vector(v: Sequence[float], name: str) -> FloatArray:
     return a
 
 
-class RigidPlane:
+class Translatable:
+    """A rigid obstacle placed by a reference point (``anchor``) that moves."""
+
+    anchor_name = "point"
+
+    def _init_anchor(self) -> None:
+        self._initial = getattr(self, self.anchor_name).copy()
+        self.displacement = np.zeros(len(self._initial))
+
+    def move_to(self, displacement: Sequence[float]) -> None:
+        """Place the obstacle at its initial position translated by ``displacement``."""
+        d = _vector(displacement, "displacement")
+        if len(d) != len(self._initial):
+            raise ValueError(f"a {len(d)}D displacement for a {len(self._initial)}D obstacle")
+        self.displacement = d
+        setattr(self, self.anchor_name, self._initial + d)
+
+
+class RigidPlane(Translatable):
     """The half-space behind a plane through ``point`` with outward ``normal``.
 
     The normal points out of the obstacle, into the space where the body is.
@@ -49,6 +73,7 @@ class RigidPlane:
             raise ValueError("the plane's normal is zero")
         self.normal = n / length
         self.gdim = len(n)
+        self._init_anchor()
 
     def signed_distance(self, x: FloatArray) -> FloatArray:
         return (x - self.point) @ self.normal
@@ -60,8 +85,10 @@ class RigidPlane:
         return np.zeros((len(x), self.gdim, self.gdim))
 
 
-class RigidSphere:
+class RigidSphere(Translatable):
     """A solid ball (a disk in 2D: the section of a rigid cylinder)."""
+
+    anchor_name = "center"
 
     def __init__(self, center: Sequence[float], radius: float):
         self.center = _vector(center, "center")
@@ -69,6 +96,7 @@ class RigidSphere:
             raise ValueError(f"the radius must be positive, got {radius}")
         self.radius = float(radius)
         self.gdim = len(self.center)
+        self._init_anchor()
 
     def signed_distance(self, x: FloatArray) -> FloatArray:
         return np.linalg.norm(x - self.center, axis=1) - self.radius
@@ -85,7 +113,7 @@ class RigidSphere:
         return (eye - unit[:, :, None] * unit[:, None, :]) / length[:, None, None]
 
 
-class RigidCylinder:
+class RigidCylinder(Translatable):
     """A solid circular cylinder in 3D with an axis through ``point`` along ``axis``."""
 
     def __init__(self, point: Sequence[float], axis: Sequence[float], radius: float):
@@ -98,6 +126,7 @@ class RigidCylinder:
             raise ValueError(f"the radius must be positive, got {radius}")
         self.radius = float(radius)
         self.gdim = 3
+        self._init_anchor()
 
     def _radial(self, x: FloatArray) -> FloatArray:
         r = x - self.point

@@ -23,7 +23,7 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.cut_quadrature import positive_part_rule
-from dolfinx_mortar.surfaces.lagrange import _measure_from_tangents
+from dolfinx_mortar.surfaces.lagrange import measure_from_tangents
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 
 if TYPE_CHECKING:
@@ -87,7 +87,7 @@ def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: Fl
     N, dN = reference.tabulate(X, transformed=False)
     coords = slave.x[cells[c]]
     tangents = [np.einsum("nb,nbk->nk", dN[:, t, :], coords) for t in range(slave.tdim)]
-    w = w_ref * _measure_from_tangents(tangents)
+    w = w_ref * measure_from_tangents(tangents)
     x = np.einsum("nb,nbk->nk", N, x_nodes[cells[c]])
     dq = -model.obstacle.signed_distance(x)
     # the rule covers {d > 0} up to the bisection tolerance: clip the rest
@@ -99,7 +99,7 @@ def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: Fl
 
     row_cells = np.concatenate(rows)
     gaps = slave.layout.sum_at_functions(row_cells, np.concatenate(values))
-    cols = model._node_dofs(row_cells).reshape(len(row_cells), nd * gdim)
+    cols = model.node_dofs(row_cells).reshape(len(row_cells), nd * gdim)
     G = _assemble_gap_derivative(model, row_cells, cols,
                                  np.concatenate(blocks).reshape(len(row_cells), nd, nd * gdim))
     return gaps, G
@@ -129,7 +129,7 @@ class MortarPointGaps:
         bs = model.slave.gdim
         Ns, Nm = pts["slave_N"], pts["master_N"]
         npts = len(self.d0)
-        slave_dofs = model._node_dofs(self.rows)
+        slave_dofs = model.node_dofs(self.rows)
         master_dofs = (coupling.master_global_ids[master_cells][..., None] * bs
                        + np.arange(bs))
         width = (Ns.shape[1] + Nm.shape[1]) * bs

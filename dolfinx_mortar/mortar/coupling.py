@@ -113,13 +113,13 @@ def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
                        global_ids.ravel())
 
 
-def _polynomial_degree(surface: LagrangeSurface) -> int:
+def polynomial_degree(surface: LagrangeSurface) -> int:
     """Total degree of the basis in reference coordinates (Q_k: 2k)."""
     k = surface.reference.degree
     return 2 * k if surface.reference.cell == "quadrilateral" else k
 
 
-def _segment_quadrature(tdim: int, degree: int) -> tuple[FloatArray, FloatArray]:
+def segment_quadrature(tdim: int, degree: int) -> tuple[FloatArray, FloatArray]:
     cell = basix.CellType.interval if tdim == 1 else basix.CellType.triangle
     return basix.make_quadrature(cell, degree)
 
@@ -200,10 +200,10 @@ class MortarCoupling:
         candidates = _kernels.overlapping_box_pairs(slave_boxes, master_boxes)
         self.timings["search"] = time.perf_counter() - clock
         clock = time.perf_counter()
-        degree = quadrature_degree or (_polynomial_degree(slave)
-                                       + max(_polynomial_degree(slave),
-                                             _polynomial_degree(master)))
-        points, weights = _segment_quadrature(slave.tdim, degree)
+        degree = quadrature_degree or (polynomial_degree(slave)
+                                       + max(polynomial_degree(slave),
+                                             polynomial_degree(master)))
+        points, weights = segment_quadrature(slave.tdim, degree)
         #: the length scale of every geometric decision, the same on every rank
         #: (the master copy is global, the slave's points are reduced)
         self.length_scale = max(length_scale(xs, comm),
@@ -287,7 +287,7 @@ class MortarCoupling:
             self._covered_mass = (L, covered, W)
         return self._covered_mass
 
-    def _covered_coefficients(self, kind: BasisKind) -> FloatArray:
+    def covered_coefficients(self, kind: BasisKind) -> FloatArray:
         """Dual coefficients rebuilt on the covered part of every covered cell
         (consistent boundary modification, Popp et al. 2013).
 
@@ -327,7 +327,7 @@ class MortarCoupling:
             if kind not in (BasisKind.LcLS_star, BasisKind.LcLS):
                 raise ValueError("the consistent boundary modification applies to the dual "
                                  f"kinds LcLS* and LcLS, not {kind_name(kind)}")
-            C = self._covered_coefficients(kind)
+            C = self.covered_coefficients(kind)
         else:
             C = basis.coefficients
         if C is None:  # global kinds: integrals in N, applied through L⁻¹ later
@@ -372,7 +372,7 @@ class MortarOperators:
         """``S v`` for the global kinds (identity for the local ones)."""
         if not self.is_global:
             return values
-        x = self.basis._solver.solve(values)
+        x = self.basis.mass_solver.solve(values)
         return x * self.basis.lumped_weights if self.kind == BasisKind.GLS_star else x
 
     def nodal_gap(self) -> FloatArray:

@@ -297,7 +297,7 @@ class LagrangeSurface:
         coords = self.x[self.cells[cells]]  # (n, nd, gdim)
         x = np.einsum("nk,nkg->ng", N_geo, coords)
         tangents = [np.einsum("nk,nkg->ng", dN[:, t, :], coords) for t in range(self.tdim)]
-        return N, x, _measure_from_tangents(tangents)
+        return N, x, measure_from_tangents(tangents)
 
     def tabulate(self, quadrature_degree: Optional[int] = None,
                  transformed: bool = True) -> Tabulation:
@@ -315,7 +315,7 @@ class LagrangeSurface:
         # matmul broadcasts over cells and is several times faster than einsum here
         points = N_geo @ coords
         tangents = [dN[:, t, :] @ coords for t in range(self.tdim)]  # (nc, nq, gdim) each
-        measure = _measure_from_tangents(tangents)
+        measure = measure_from_tangents(tangents)
         nc, nq = len(self.cells), len(X)
         phi = np.broadcast_to(N, (nc, nq, N.shape[1]))
         return Tabulation(phi=np.ascontiguousarray(phi), weights=measure * wq[None, :],
@@ -329,7 +329,7 @@ class LagrangeSurface:
         return cells, N
 
 
-def _measure_from_tangents(tangents: list) -> FloatArray:
+def measure_from_tangents(tangents: list) -> FloatArray:
     """|t₀| (lines) or |t₀ × t₁| (surfaces, which live in 3D).
 
     The cross product, not sqrt(|t₀|²|t₁|² − (t₀·t₁)²): that difference

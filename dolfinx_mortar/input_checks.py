@@ -137,3 +137,41 @@ def unused_petsc_options(prefix: str, ignore: Iterable[str] = ()) -> list[str]:
         if used_query(None, name.encode(), ctypes.byref(used)) == 0 and not used.value:
             unused.append("-" + name)
     return sorted(unused)
+
+
+def check_tags(mesh, facet_tags, tags: Iterable) -> None:
+    """Integer facet tags that mark facets somewhere (on any rank).
+
+    Raises
+    ------
+    TypeError
+        For non-integer tag values, in the meshtags or among ``tags``.
+    ValueError
+        For a tag that marks no facet, with the tags present.
+    """
+    if not np.issubdtype(np.asarray(facet_tags.values).dtype, np.integer):
+        raise TypeError(f"facet tag values must be integers, got "
+                        f"{np.asarray(facet_tags.values).dtype}")
+    if facet_tags.dim != mesh.topology.dim - 1:
+        raise ValueError(f"the meshtags have dimension {facet_tags.dim}; contact needs facet "
+                         f"tags (dimension {mesh.topology.dim - 1})")
+    present = {int(t) for values in mesh.comm.allgather(np.unique(facet_tags.values))
+               for t in values}
+    for tag in tags:
+        if tag is None:
+            continue
+        if not isinstance(tag, (int, np.integer)):
+            raise TypeError(f"tags must be integers, got {tag!r} ({type(tag).__name__})")
+        if tag not in present:
+            raise ValueError(f"facet tag {tag} marks no facets (tags present: "
+                             f"{sorted(present)})")
+
+
+def check_contact_tags(mesh, facet_tags, slave_tag: int, master_tag: Optional[int]) -> None:
+    """Slave and master tags as :func:`check_tags`, and no facet carrying both."""
+    check_tags(mesh, facet_tags, [slave_tag, master_tag])
+    if master_tag is not None:
+        a, b = facet_tags.find(slave_tag), facet_tags.find(master_tag)
+        if mesh.comm.allreduce(len(np.intersect1d(a, b))) > 0:
+            raise ValueError(f"slave tag {slave_tag} and master tag {master_tag} "
+                             "overlap: a facet cannot be both")

@@ -1,0 +1,112 @@
+"""The gap model of GLS and GLS*: nodal gaps through the global mass matrix.
+
+``d̄ = L⁻¹ ĝ(u)`` with ``ĝ_B = ∫ N_B d`` (DESIGN.md §3). ``M_A`` has global
+support, so ``G = L⁻¹ Ĝ`` is dense: only the sparse ``Ĝ = ∂ĝ/∂u`` and ``L``
+are assembled, and the Newton step solves the augmented system
+(:class:`~dolfinx_mortar.contact.augmented.AugmentedNewtonStep`).
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+from petsc4py import PETSc
+
+from dolfinx_mortar.bases.basis import MortarBasis
+from dolfinx_mortar.contact.gaps import GapModelBase
+from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.kinds import BasisKind, KindLike, parse_kind
+from dolfinx_mortar.layout import MassMatrixSolver
+from dolfinx_mortar.mortar.coupling import MortarCoupling
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def covered_mass(coupling: MortarCoupling) -> tuple[MassMatrixSolver, FloatArray]:
+    """``L_AB = ∫_cov N_A N_B`` over the covered slave area, factorized, and its
+    row sums ``W_A = ∫_cov N_A``. Nodes with no covered support get a unit row
+    (their gap is 0 and their weight 0)."""
+    slave = coupling.slave
+    L, covered_cells, W = coupling.covered_element_mass()
+    matrix = slave.layout.assemble_matrix(slave.cells[covered_cells], L[covered_cells])
+    return MassMatrixSolver(slave.layout, matrix), W
+
+
+class GlobalGap:
+    """Nodal gaps of GLS and GLS*: ``d̄ = L⁻¹ ĝ(u)``.
+
+    ``inner`` is a standard-basis gap model with frozen bases
+    (:class:`~dolfinx_mortar.contact.gaps.ObstacleGap` or
+    :class:`~dolfinx_mortar.contact.gaps.MortarGap` of kind LmLS*) that gives
+    ``ĝ`` and ``Ĝ``; ``mass`` the factorized ``L`` and ``lumped_weights`` its
+    row sums (over the covered part against an elastic master: with L over
+    the whole surface the uncovered part counts as d = 0 and the gaps ring
+    past the covered zone — a node beyond it got d̄ = +0.31 h on two touching
+    cylinders at zero load).
+    """
+
+    augmented = True
+    moving_pattern = False
+
+    def __init__(self, inner: GapModelBase, kind: KindLike, penalty: float, scaling: str,
+                 mass: Optional[tuple[MassMatrixSolver, FloatArray]] = None):
+        self.inner = inner
+        self.kind = parse_kind(kind)
+        self.scaling = scaling
+        self.slave = inner.slave
+        self.pointwise = inner.pointwise
+        self.coupling = inner.coupling
+        self.basis = MortarBasis(BasisKind.GLS, self.slave)
+        self.mass, W = mass if mass is not None else (self.basis.mass_solver,
+                                                      self.basis.lumped_weights)
+        #: W_A = ∫ N_A over the part that enters the projection
+        self.lumped_weights = W
+        # Π_c = Σ (ω_A/2)⟨d̄_A⟩² in terms of the GLS gap d̄ (∫M_A = 1):
+        # consistent ω = εW; seed GLS ω = ε; seed GLS* (d_A = W_A d̄_A) ω = εW².
+        if scaling == "consistent":
+            weights = penalty * W
+        elif self.kind == BasisKind.GLS:
+            weights = penalty * np.ones_like(W)
+        else:
+            weights = penalty * W ** 2
+        self.dofs = inner.dofs
+        self.covered = inner.covered
+        #: owned local nodes of the slave surface (the rows the Newton step needs)
+        owned = np.unique(self.slave.cells)
+        self.surface_rows = owned[owned < self.slave.layout.num_owned]
+        self.weights = np.where(self.covered, weights, 0.0)
+
+    def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
+        """``d̄ = L⁻¹ĝ``, Ĝ, and ``z = L⁻¹ω⟨d̄⟩`` (pointwise: ``L⁻¹ω d̄⁺``)."""
+        g, G, x, g_plus, G_plus = self.inner.raw_gaps(u)
+        gaps = self.mass.solve(g)
+        gaps_plus = None
+        if self.pointwise:
+            gaps_plus = self.mass.solve(g_plus)
+            force = self.mass.solve(self.weights * gaps_plus)
+        else:
+            force = self.mass.solve(self.weights * np.maximum(gaps, 0.0))
+        K_curv = self.inner.curvature(force, x) if x is not None else None
+        return self.inner.state(gaps, G, force, mask, gaps_plus, G_plus, K_curv)
+
+    def jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
+                 geometric: bool = True) -> PETSc.Mat:
+        raise NotImplementedError(
+            "GLS kinds have a dense Newton matrix; the contact term applies the exact step "
+            "through the augmented system (ContactTerm.configure_ksp)")
+
+    def nodal_force(self, values: FloatArray) -> FloatArray:
+        """``z = L⁻¹ values``: the nodal force of ``R_c = Ĝᵀ z``."""
+        return self.mass.solve(values)
+
+    def nodal_pressures(self, state: ContactState) -> FloatArray:
+        """``p_A = ω_A⟨d̄_A⟩/W_A`` (pointwise: ``ω_A d̄⁺_A/W_A``), the
+        coefficients of the traction in the PU basis GLS*."""
+        W = self.lumped_weights
+        gaps = state.gaps_plus if state.gaps_plus is not None else np.maximum(state.gaps, 0.0)
+        return np.divide(self.weights * gaps, W, out=np.zeros_like(W), where=W > 0)
+
+    def mortar_traction(self, state: ContactState) -> FloatArray:
+        """``p* = Σ_A f_A (N L⁻¹)_A = Σ_B N_B z_B`` at the nodes of every slave cell."""
+        return state.force[self.slave.cells]

@@ -1,0 +1,193 @@
+"""What a contact term reports: gaps, pressures, tractions, forces, and the
+warnings about a configuration that has left the model's range.
+
+Each figure, with what it is:
+
+- :meth:`ContactResults.nodal_pressures`: ``p_A``, the coefficients of the
+  contact pressure in the partition-of-unity basis (``ε⟨d̄_A⟩``);
+- :meth:`ContactResults.mortar_traction`: ``p* = Σ f_A M_A`` per slave cell,
+  the traction whose virtual work the residual is;
+- :meth:`ContactResults.normal_force`: ``Σ_A W_A p_A``, the integral of the
+  pressure (a scalar, on the surface the bases live in);
+- :meth:`ContactResults.contact_force`: the resultant vector of the contact
+  traction on the slave body, ``−Σ R_c`` over its dofs: what a load cell
+  would read. On a curved contact it differs from ``normal_force`` by the
+  tilt of the normals (and in the current configuration by the area change).
+"""
+from __future__ import annotations
+
+import warnings
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
+
+FloatArray = npt.NDArray[np.float64]
+
+#: an initial penetration deeper than this many slave element lengths is warned about
+DEEP_PENETRATION = 0.5
+#: basis_configuration="initial" is warned about past this many element lengths of slip
+SLIP_LIMIT = 1.0
+
+
+class ContactResults:
+    """Results of a :class:`~dolfinx_mortar.contact.term.ContactTerm` at the present u."""
+
+    def evaluate(self) -> ContactState:
+        """The contact state at the present u with every dof kept (results)."""
+        self.u.x.scatter_forward()
+        return self.model.evaluate(self.u, None)
+
+    def nodal_gaps(self) -> FloatArray:
+        """``d̄_A`` (penetration positive) at the local slave-layout nodes."""
+        return self.evaluate().gaps
+
+    def nodal_pressures(self, state: Optional[ContactState] = None) -> FloatArray:
+        """Contact pressure ``p_A`` at the local slave-layout nodes (0 off the surface)."""
+        return self.model.nodal_pressures(state or self.evaluate())
+
+    def mortar_traction(self, state: Optional[ContactState] = None) -> FloatArray:
+        """The contact traction ``p*`` at the nodes of every slave cell, (cells, nodes):
+        one set per cell, since ``p*`` of the dual kinds jumps between cells."""
+        return self.model.mortar_traction(state or self.evaluate())
+
+    def normal_force(self, state: Optional[ContactState] = None) -> float:
+        """``∫ p dA = Σ_A W_A p_A`` over all ranks (a scalar)."""
+        n = self.slave.layout.num_owned
+        p = self.nodal_pressures(state)
+        W = self.model.lumped_weights
+        return float(self.mesh.comm.allreduce(float(np.sum((W * p)[:n]))))
+
+    def contact_force(self, state: Optional[ContactState] = None) -> FloatArray:
+        """The resultant of the contact traction on the slave body, a gdim-vector:
+        ``−Σ R_c`` over the slave nodes' dofs, summed over all ranks."""
+        state = state or self.evaluate()
+        gdim = self.slave.gdim
+        R = state.residual.array_r.reshape(-1, gdim)
+        nodes = np.unique(self.slave.cells)
+        nodes = nodes[nodes < self.slave.layout.num_owned]
+        local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
+        return np.asarray(self.mesh.comm.allreduce(local))
+
+    def active_nodes(self, state: Optional[ContactState] = None) -> int:
+        """The number of slave nodes with a positive pressure, over all ranks."""
+        p = self.nodal_pressures(state)
+        return int(self.mesh.comm.allreduce(
+            int(np.sum(p[: self.slave.layout.num_owned] > 0))))
+
+    # -- range of the model ------------------------------------------------------------
+    def _node_lengths(self) -> FloatArray:
+        """Each local slave node's element length: the largest of its cells'."""
+        slave = self.slave
+        cell_length = slave.tabulate().weights.sum(axis=1) ** (1.0 / slave.tdim)
+        length = np.zeros(slave.layout.size_local)
+        np.maximum.at(length, slave.cells, np.repeat(cell_length[:, None],
+                                                     slave.cells.shape[1], axis=1))
+        return length
+
+    def warn_deep_initial_penetration(self) -> None:
+        """Warn when the configuration penetrates by more than DEEP_PENETRATION
+        slave element lengths (a rigid plane placed 0.2 deep into a 0.5-high
+        block solved without a word)."""
+        gaps = self.nodal_gaps()
+        slave = self.slave
+        n = slave.layout.num_owned
+        length = self._node_lengths()
+        covered = self.model.covered & slave.layout.on_cells(slave.cells)
+        depth = np.where(covered, gaps / np.where(covered, length, 1.0), -np.inf)[:n]
+        worst = int(np.argmax(depth)) if n else -1
+        local = ((float(depth[worst]), float(gaps[worst]), slave.x[worst].tolist())
+                 if n else (-np.inf, 0.0, []))
+        ratio, gap, x = max(self.mesh.comm.allgather(local), key=lambda item: item[0])
+        if ratio > DEEP_PENETRATION:
+            warnings.warn(f"the initial configuration penetrates by {gap:.3g} ({ratio:.3g} "
+                          f"slave element lengths) at the slave node {x}: check the "
+                          "obstacle's position and normal, or the tags of slave and master",
+                          RuntimeWarning, stacklevel=3)
+
+    def slip(self) -> float:
+        """The largest tangential slip of an active slave node since the bases
+        were built, in element lengths of that node (over all ranks).
+
+        Slip is the node's displacement relative to what it touches (the
+        obstacle's motion, or the mean displacement of the master nodes of the
+        master cells its cells were paired with), without the normal part.
+        """
+        state = self.evaluate()
+        slave = self.slave
+        u_nodes = nodal_displacement(slave, self.u)
+        other = self._partner_displacement(u_nodes)
+        measure = slave.tabulate().weights.sum(axis=1)
+        weighted = slave.cell_normals() * measure[:, None, None]
+        normals = np.stack([slave.layout.sum_at_functions(slave.cells, weighted[..., k])
+                            for k in range(slave.gdim)], axis=1)
+        size = np.linalg.norm(normals, axis=1)
+        normals = normals / np.where(size > 0, size, 1.0)[:, None]
+        relative = u_nodes - other
+        tangential = relative - np.einsum("ak,ak->a", relative, normals)[:, None] * normals
+        active = (self.model.nodal_pressures(state) > 0)
+        ratio = np.where(active, np.linalg.norm(tangential, axis=1)
+                         / np.maximum(self._node_lengths(), np.finfo(float).tiny), 0.0)
+        n = slave.layout.num_owned
+        return float(self.mesh.comm.allreduce(float(np.max(ratio[:n], initial=0.0)),
+                                               op=_max_op()))
+
+    def _partner_displacement(self, u_nodes: FloatArray) -> FloatArray:
+        """What each slave node touches moves by: the obstacle's displacement, or
+        the mean displacement of the master nodes paired with the node's cells
+        (master nodes may live on other ranks: fetched by global index)."""
+        if self.obstacle is not None:
+            return np.broadcast_to(self.obstacle.displacement, u_nodes.shape)
+        coupling = self.model.coupling
+        gdim = self.slave.gdim
+        pairs = coupling.pairs
+        nodes = coupling.master_global_ids[coupling.master_cells[pairs[:, 1]]]
+        dofs = (nodes[..., None] * gdim + np.arange(gdim)).ravel().astype(PETSc.IntType)
+        values = _gather_entries(self.u.vector, dofs).reshape(nodes.shape + (gdim,))
+        master_mean = values.mean(axis=1)
+        count = np.zeros(self.slave.layout.size_local)
+        total = np.zeros_like(u_nodes)
+        for b in range(self.slave.cells.shape[1]):
+            ends = self.slave.cells[pairs[:, 0], b]
+            np.add.at(total, ends, master_mean)
+            np.add.at(count, ends, 1.0)
+        return total / np.maximum(count, 1.0)[:, None]
+
+    def warn_if_slipped_too_far(self) -> None:
+        """With ``basis_configuration="initial"``: warn (once) past SLIP_LIMIT
+        element lengths of slip (:meth:`slip`). A press-then-slide run gave a
+        normal force growing 3× and a frictionless tangential force of 33% of
+        it without a word. Against a rigid obstacle the gap is exact in u
+        whatever the slip (no segmentation is frozen): no warning."""
+        if (self.basis_configuration != "initial" or self.obstacle is not None
+                or getattr(self, "_slip_warned", False)):
+            return
+        s = self.slip()
+        if s > SLIP_LIMIT:
+            self._slip_warned = True
+            warnings.warn(f"contact surfaces slipped {s:.3g} element lengths past the "
+                          "configuration of the bases (basis_configuration='initial', valid "
+                          "to about one element of slip): the forces are no longer reliable; "
+                          "use basis_configuration='previous' or 'current'",
+                          RuntimeWarning, stacklevel=3)
+
+
+def _max_op():
+    return MPI.MAX
+
+
+def _gather_entries(vec: PETSc.Vec, indices: npt.NDArray) -> FloatArray:
+    """The entries of a distributed vector at global ``indices`` (any rank's)."""
+    target = PETSc.Vec().createSeq(len(indices), comm=PETSc.COMM_SELF)
+    source = PETSc.IS().createGeneral(indices, comm=PETSc.COMM_SELF)
+    scatter = PETSc.Scatter().create(vec, source, target, None)
+    scatter.scatter(vec, target, addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+    values = target.array.copy()
+    for obj in (scatter, source, target):
+        obj.destroy()
+    return values

@@ -1,0 +1,74 @@
+"""What every gap model returns: the contact state at one displacement.
+
+All gap models — rigid obstacle, elastic master, GLS/GLS*, pointwise active
+set, current configuration — answer the same three questions
+(:class:`GapModel`): the state at a displacement (:meth:`GapModel.evaluate`),
+the contact stiffness at that state (:meth:`GapModel.jacobian`), and the
+pressures and traction it carries. The contact term
+(:class:`~dolfinx_mortar.contact.term.ContactTerm`) only talks to this
+interface.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Optional, Protocol
+
+import numpy as np
+import numpy.typing as npt
+from petsc4py import PETSc
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass
+class ContactState:
+    """The contact terms at one displacement.
+
+    The contact residual is ``residual = Gᵀ force``. ``G`` is the derivative
+    of the nodal gaps d̄ with respect to the displacement dofs, with the
+    Dirichlet columns dropped (for GLS kinds Ĝ of ĝ, and ``force`` is
+    z = L⁻¹ω⟨d̄⟩). ``gaps_plus`` and ``G_plus`` are the pointwise active set's
+    d̄⁺ and its derivative (None with the nodal set); ``K_curv`` the obstacle's
+    curvature stiffness (None if flat); ``data`` what a model's Jacobian
+    needs beyond that (the current configuration's).
+    """
+
+    gaps: FloatArray
+    G: PETSc.Mat
+    force: FloatArray
+    residual: PETSc.Vec
+    K_curv: Optional[PETSc.Mat] = None
+    gaps_plus: Optional[FloatArray] = None
+    G_plus: Optional[PETSc.Mat] = None
+    data: Any = None
+
+
+class GapModel(Protocol):
+    """The one interface of the gap models (:mod:`~dolfinx_mortar.contact.gaps`,
+    :mod:`~dolfinx_mortar.contact.global_gap`,
+    :mod:`~dolfinx_mortar.contact.finite_deformation`,
+    :mod:`~dolfinx_mortar.contact.current_mortar`)."""
+
+    #: slave nodes that have something (master or obstacle) to touch
+    covered: npt.NDArray[np.bool_]
+    #: ω_A of the penalty potential Π_c = Σ (ω_A/2)⟨d̄_A⟩²
+    weights: FloatArray
+    #: the Newton matrix is dense (GLS kinds): the step comes from an augmented system
+    augmented: bool
+    #: the pairs, and so the matrix pattern, change inside a Newton solve
+    moving_pattern: bool
+
+    @property
+    def lumped_weights(self) -> FloatArray: ...
+
+    def evaluate(self, u: Any, mask: Optional[PETSc.Vec]) -> ContactState:
+        """The state at the displacement Function ``u``; ``mask`` is 1 on free
+        dofs and 0 on Dirichlet dofs (None: keep every column)."""
+
+    def jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
+                 geometric: bool = True) -> PETSc.Mat:
+        """The contact stiffness with ``active`` (0/1 per node) as H(d̄)."""
+
+    def nodal_pressures(self, state: ContactState) -> FloatArray: ...
+
+    def mortar_traction(self, state: ContactState) -> FloatArray: ...

@@ -1,0 +1,336 @@
+"""Penalty mortar contact as a term of the user's own DOLFINx model.
+
+:class:`ContactTerm` adds the contact residual and Jacobian of one slave
+surface (against an elastic master in the same mesh or a rigid analytic
+obstacle) to PETSc vectors and matrices that already hold the user's bulk
+forms — in the style of :mod:`dolfinx.fem.petsc`::
+
+    contact = ContactTerm(u, facet_tags, slave_tag=3, obstacle=RigidPlane(...),
+                          kind="LcLS*", penalty=1e3 * E / h)
+    A = contact.create_matrix(fem.form(J))       # bulk ∪ contact pattern
+    ...
+    contact.assemble_residual(b, bcs)            # b += R_c(u)
+    contact.assemble_jacobian(A, bcs)            # A += K_c(u)
+
+:class:`~dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem`
+does exactly this around the user's residual form.
+"""
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from typing import Iterator, Optional, Sequence
+
+import dolfinx.la
+import numpy as np
+import numpy.typing as npt
+from dolfinx import fem
+from dolfinx.fem import petsc as fem_petsc
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar.contact.augmented import AugmentedNewtonStep
+from dolfinx_mortar.contact.models import ContactOptions, current_model, frozen_model, moved
+from dolfinx_mortar.contact.obstacles import RigidObstacle
+from dolfinx_mortar.contact.results import ContactResults
+from dolfinx_mortar.contact.state import ContactState, GapModel
+from dolfinx_mortar.kinds import KindLike
+from dolfinx_mortar.input_checks import check_cells, check_contact_tags
+from dolfinx_mortar.surfaces.facet_surface import facet_surface, nodal_displacement
+
+FloatArray = npt.NDArray[np.float64]
+SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
+DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+
+
+class ContactTerm(ContactResults):
+    """The penalty mortar contact term of one slave surface.
+
+    Parameters
+    ----------
+    u
+        The displacement, a vector Lagrange Function of degree 1 or 2 (the
+        unknown of the user's model).
+    facet_tags
+        Facet meshtags of u's mesh.
+    slave_tag
+        Tag of the slave facets.
+    master_tag
+        Tag of the master facets in the same mesh (two bodies), or None.
+    obstacle
+        A rigid analytic obstacle instead of a master surface
+        (:mod:`dolfinx_mortar.contact.obstacles`); it may be moved between
+        load steps (``obstacle.move_to``).
+    kind
+        Mortar basis kind, any of the six (DESIGN.md §2).
+    penalty
+        ε, pressure per length (consistent scaling).
+    scaling
+        ``"consistent"`` (default) or ``"seed"`` (DESIGN.md §3).
+    active_set
+        ``"nodal"`` (default, penalty on ⟨d̄_A⟩) or ``"pointwise"``
+        (``p_A = ε∫M̄_A⟨d⟩``, unsymmetric exact Jacobian).
+    basis_configuration
+        ``"initial"`` (default): bases and segmentation in the reference
+        configuration, good up to about one element of slip;
+        ``"previous"``: rebuilt when a load step starts (:meth:`begin_step`);
+        ``"current"``: on the current surfaces at every evaluation, with the
+        exact linearization (local kinds).
+    quadratic_transform
+        Transformed basis on quadratic triangle facets.
+    boundary_modification
+        Elastic master, dual kinds: the basis rebuilt over the covered part of
+        partly covered slave facets (Popp et al. 2013).
+    search_radius
+        How far apart slave and master facets may be and still be paired
+        (default the largest slave facet diameter).
+    """
+
+    def __init__(self, u: fem.Function, facet_tags, slave_tag: int, *,
+                 master_tag: Optional[int] = None, obstacle: Optional[RigidObstacle] = None,
+                 kind: KindLike = "LcLS*", penalty: float, scaling: str = "consistent",
+                 active_set: str = "nodal", basis_configuration: str = "initial",
+                 quadratic_transform: bool = False, boundary_modification: bool = False,
+                 search_radius: Optional[float] = None):
+        if not isinstance(u, fem.Function):
+            raise TypeError(f"u must be a dolfinx.fem.Function (the displacement), got "
+                            f"{type(u).__name__}")
+        V = u.function_space
+        mesh = V.mesh
+        gdim = mesh.geometry.dim
+        if V.dofmap.index_map_bs != gdim:
+            raise ValueError(f"u must be a vector Function with {gdim} components per node")
+        if (master_tag is None) == (obstacle is None):
+            raise ValueError("give exactly one of master_tag (elastic master) and obstacle "
+                             "(rigid analytic obstacle)")
+        if obstacle is not None and obstacle.gdim != gdim:
+            raise ValueError(f"a {obstacle.gdim}D obstacle in a {gdim}D mesh: the option "
+                             "does not fit the mesh's dimension")
+        self.options = ContactOptions.checked(kind, penalty, scaling, active_set,
+                                              basis_configuration, boundary_modification,
+                                              search_radius, master_tag is not None)
+        check_cells(mesh)
+        check_contact_tags(mesh, facet_tags, slave_tag, master_tag)
+        self.u, self.V, self.mesh = u, V, mesh
+        self.obstacle = obstacle
+        self.slave = facet_surface(V, facet_tags, slave_tag, quadratic_transform)
+        self.master = (facet_surface(V, facet_tags, master_tag) if master_tag is not None
+                       else None)
+        #: wall times of the contact work by part, seconds (accumulated)
+        self.timings: dict[str, float] = {}
+        self.state: Optional[ContactState] = None
+        self._masks: dict = {}
+        self._last_active: Optional[FloatArray] = None
+        self._augmented: Optional[AugmentedNewtonStep] = None
+        self._built_at: Optional[FloatArray] = None
+        self.model: GapModel = self._build(None)
+        self.warn_deep_initial_penetration()
+
+    # -- configuration ---------------------------------------------------------------
+    @property
+    def basis_configuration(self) -> str:
+        return self.options.basis_configuration
+
+    def _build(self, u_nodes: Optional[FloatArray]) -> GapModel:
+        clock = time.perf_counter()
+        if self.basis_configuration == "current":
+            model = current_model(self.options, self.slave, self.master, self.obstacle)
+        else:
+            model = frozen_model(self.options, self.slave, self.master, self.obstacle,
+                                 u_nodes, None if u_nodes is None else self.u.vector.copy())
+            self._built_at = None if u_nodes is None else u_nodes.copy()
+        self._last_active, self.state = None, None
+        self.timings["setup"] = time.perf_counter() - clock
+        return model
+
+    def begin_step(self) -> bool:
+        """Called by a load-path driver when a load step starts.
+
+        With ``basis_configuration="previous"`` the bases (and segmentation)
+        are rebuilt in the configuration of the last converged step if u moved
+        since they were built; returns True then (the contact pattern may have
+        changed: :meth:`create_matrix` again).
+        """
+        if self.basis_configuration != "previous":
+            return False
+        u_nodes = nodal_displacement(self.slave, self.u)
+        if not moved(u_nodes, self._built_at, self.mesh.comm):
+            return False
+        self.model = self._build(u_nodes)
+        return True
+
+    @contextmanager
+    def frozen(self) -> Iterator[None]:
+        """With ``basis_configuration="current"``: the model frozen at the present u
+        (the "previous" model) inside the block. A load-path driver solves each
+        step with it first; other configurations are unchanged."""
+        if self.basis_configuration != "current":
+            yield
+            return
+        current = self.model
+        self.model = frozen_model(self.options, self.slave, self.master, self.obstacle,
+                                  nodal_displacement(self.slave, self.u), self.u.vector.copy())
+        try:
+            yield
+        finally:
+            self.model, self.state, self._last_active = current, None, None
+
+    @property
+    def moving_pattern(self) -> bool:
+        """Whether the matrix pattern may change inside a Newton solve."""
+        return self.model.moving_pattern
+
+    @property
+    def augmented(self) -> bool:
+        """Whether the Newton step needs :meth:`configure_ksp` (GLS kinds)."""
+        return self.model.augmented
+
+    # -- PETSc assembly --------------------------------------------------------------
+    def mask(self, bcs: Sequence[fem.DirichletBCMetaClass] = ()) -> PETSc.Vec:
+        """1 on free dofs, 0 on the dofs of ``bcs`` (the contact terms skip those)."""
+        key = tuple(id(bc) for bc in bcs)
+        if key not in self._masks:
+            index_map = self.V.dofmap.index_map
+            m = dolfinx.la.create_petsc_vector(index_map, self.V.dofmap.index_map_bs)
+            m.set(1.0)
+            fem_petsc.set_bc(m, list(bcs), scale=0.0)
+            self._masks[key] = m
+        return self._masks[key]
+
+    def update(self, bcs: Sequence = ()) -> ContactState:
+        """The contact state at the present values of u (ghosts updated here)."""
+        clock = time.perf_counter()
+        self.u.x.scatter_forward()
+        self.state = self.model.evaluate(self.u, self.mask(bcs))
+        self._add("residual", clock)
+        return self.state
+
+    def assemble_residual(self, b: PETSc.Vec, bcs: Sequence = ()) -> None:
+        """``b += R_c(u)`` on the owned entries (R_c = 0 on the dofs of ``bcs``).
+
+        Evaluates the contact state at u (:meth:`update`); call it before
+        :meth:`assemble_jacobian`, as Newton does.
+        """
+        b.axpy(1.0, self.update(bcs).residual)
+
+    def assemble_jacobian(self, A: PETSc.Mat, bcs: Sequence = ()) -> None:
+        """``A += K_c`` at the state of the last :meth:`update` (A assembled after).
+
+        GLS kinds: A is left as it is (the bulk) and the exact Newton step of
+        the augmented system is prepared instead (:meth:`configure_ksp`).
+        """
+        if self.state is None:
+            self.update(bcs)
+        clock = time.perf_counter()
+        mask = self.mask(bcs)
+        state = self.state
+        if self.model.augmented:
+            self._prepare_augmented(A, state)
+        else:
+            settled = True
+            active = self.active_nodes_mask(state)
+            if self.basis_configuration == "current":
+                # Far from the solution the pressure on the current surface can
+                # be many times its final value, and so its geometric stiffness:
+                # full Newton steps then cycled between active sets (Hertz 2D).
+                # While the active set moves the frozen-surface part alone gives
+                # the step; once it settles the exact Jacobian converges
+                # quadratically.
+                settled = self.mesh.comm.allreduce(bool(
+                    self._last_active is not None
+                    and np.array_equal(active, self._last_active)), op=MPI.LAND)
+                self._last_active = active
+            K = self.model.jacobian(state, active, mask, geometric=settled)
+            A.axpy(1.0, K, structure=SUBSET)
+            A.assemble()
+        self._add("jacobian", clock)
+
+    def _prepare_augmented(self, A: PETSc.Mat, state: ContactState) -> None:
+        model = self.model
+        K = A.copy()
+        if state.K_curv is not None:
+            K.axpy(1.0, state.K_curv, structure=DIFFERENT)
+        G_right, weights = state.G, model.weights * self.active_nodes_mask(state)
+        if state.gaps_plus is not None and model.inner.any_penetration(state.gaps_plus):
+            G_right, weights = state.G_plus, model.weights
+        if self._augmented is None:
+            self._augmented = AugmentedNewtonStep(self.mesh.comm, self.augmented_prefix)
+        self._augmented.update(K, state.G, weights, model.mass.matrix, G_right,
+                               model.surface_rows)
+
+    @property
+    def augmented_step(self) -> Optional[AugmentedNewtonStep]:
+        """GLS kinds: the exact Newton step of the last :meth:`assemble_jacobian`."""
+        return self._augmented
+
+    #: options prefix of the augmented system's KSP (GLS kinds)
+    augmented_prefix = "dolfinx_mortar_augmented_"
+
+    def configure_ksp(self, ksp: PETSc.KSP) -> None:
+        """Make ``ksp`` apply the exact Newton step (GLS kinds: the augmented
+        system, a python PC; other kinds: nothing to do)."""
+        if not self.model.augmented:
+            return
+        if self._augmented is None:
+            self._augmented = AugmentedNewtonStep(self.mesh.comm, self.augmented_prefix)
+        ksp.setType("preonly")
+        ksp.getPC().setType("python")
+        ksp.getPC().setPythonContext(self._augmented)
+
+    def create_matrix(self, a: fem.FormMetaClass, bcs: Sequence = ()) -> PETSc.Mat:
+        """A matrix whose pattern holds the bilinear form ``a`` and the contact
+        stiffness (of every active set), with ``a`` assembled in it."""
+        A = fem_petsc.create_matrix(a)
+        fem_petsc.assemble_matrix(A, a, list(bcs))
+        A.assemble()
+        if self.model.augmented:
+            return A
+        state = self.state or self.update(bcs)
+        K = self.model.jacobian(state, np.ones_like(self.model.weights), self.mask(bcs))
+        A.axpy(1.0, K, structure=DIFFERENT)
+        if self.moving_pattern or self.basis_configuration == "previous":
+            # the pairs, and so the pattern, change with u: new entries are
+            # allocated as they come
+            A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        return A
+
+    def active_nodes_mask(self, state: ContactState) -> FloatArray:
+        """Nodes that get contact stiffness (H(d̄) as 0/1).
+
+        The generalized derivative of ⟨·⟩ at 0 is taken as 1, so touching
+        nodes stiffen without pushing. If no node on any rank is active — a
+        body that only touches at a point, with positive mortar functions, has
+        d̄ < 0 everywhere — the covered nodes within a tenth of their element
+        length of contact get stiffness too: otherwise the rigid-body mode
+        that the contact must hold makes the Jacobian singular. Nodes with no
+        master below them have no gap and are never active.
+        """
+        covered = self.model.covered
+        active = covered & (state.gaps >= 0)
+        n = self.slave.layout.num_owned
+        if self.mesh.comm.allreduce(int(np.sum(active[:n]))) == 0:
+            length = np.power(np.maximum(self.model.basis.lumped_weights, 0.0),
+                              1.0 / self.slave.tdim)
+            active = covered & (state.gaps >= -0.1 * length)
+        return active.astype(np.float64)
+
+    def gap_closing_force(self) -> Optional[PETSc.Vec]:
+        """``Gᵀ f`` with ``f = ω d̄`` on the nodes near contact, when nothing touches
+        yet (else None): the pull that closes their gaps (a better Newton start,
+        :class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`)."""
+        state = self.state
+        n = self.slave.layout.num_owned
+        touching = (state.gaps_plus if state.gaps_plus is not None
+                    else np.where(self.model.covered, np.maximum(state.gaps, 0.0), 0.0))
+        if self.mesh.comm.allreduce(bool(np.any(touching[:n] != 0))):
+            return None
+        near = self.active_nodes_mask(state)
+        if self.mesh.comm.allreduce(int(np.sum(near[:n]))) == 0:
+            return None
+        force = self.model.nodal_force(self.model.weights * near * state.gaps)
+        pull = state.G.createVecRight()
+        state.G.multTranspose(self.slave.layout.vector(force), pull)
+        return pull
+
+    def _add(self, name: str, since: float) -> None:
+        self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since

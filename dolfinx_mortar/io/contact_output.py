@@ -1,0 +1,69 @@
+"""XDMF output of a contact solve: u and p̂ on the mesh, p̂ and p* on the slave facets.
+
+Every converged step goes to ``<output>.xdmf`` (displacement and nodal
+pressure on the mesh) and to ``<output>_slave.xdmf`` (``p_hat`` and ``p_star``
+per slave facet, since ``p*`` may jump); with several contact terms the
+second and later ones write ``<output>_slave1.xdmf``, … Both files are
+complete on disk after every step (:mod:`dolfinx_mortar.io.xdmf_series`).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+from dolfinx import fem
+
+from dolfinx_mortar.io.surface_output import SlaveSurfaceOutput, surface_output_path
+from dolfinx_mortar.io.xdmf_series import XdmfSeries
+
+
+class ContactOutput:
+    """Writes the steps of a contact solve (see the module docstring).
+
+    Parameters
+    ----------
+    path
+        The mesh file's ``.xdmf`` path.
+    u
+        The displacement Function.
+    contacts
+        The contact terms (:class:`~dolfinx_mortar.contact.term.ContactTerm`).
+    """
+
+    def __init__(self, path: Path, u: fem.Function, contacts: Sequence):
+        path = Path(path)
+        self.u, self.contacts = u, list(contacts)
+        mesh = u.function_space.mesh
+        self.mesh_output = XdmfSeries(path, mesh)
+        self.surface_outputs = []
+        for i, term in enumerate(self.contacts):
+            p = surface_output_path(path)
+            if i:
+                p = p.with_name(p.stem + str(i) + p.suffix)
+            self.surface_outputs.append(SlaveSurfaceOutput(term.slave, p))
+        V = u.function_space
+        degree = mesh.geometry.cmap.degree
+        self.V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
+        self.Q, q_to_v = V.sub(0).collapse()
+        self.q_nodes = np.asarray(q_to_v) // V.dofmap.index_map_bs
+        self.Q1 = (fem.FunctionSpace(mesh, ("Lagrange", degree))
+                   if self.Q.ufl_element().degree() != degree else None)
+
+    def write(self, t: float, states: Sequence) -> None:
+        """Add the step at pseudo-time ``t`` with each term's contact state."""
+        total = np.zeros(self.contacts[0].slave.layout.size_local)
+        for term, state, out in zip(self.contacts, states, self.surface_outputs):
+            pressures = term.nodal_pressures(state)
+            total += pressures
+            out.write({"p_hat": pressures[term.slave.cells],
+                       "p_star": term.mortar_traction(state)}, t)
+        u1 = fem.Function(self.V1, name="displacement")
+        u1.interpolate(self.u)
+        p = fem.Function(self.Q, name="contact_pressure")
+        p.x.array[:] = total[self.q_nodes]
+        if self.Q1 is not None:
+            p1 = fem.Function(self.Q1, name="contact_pressure")
+            p1.interpolate(p)
+            p = p1
+        self.mesh_output.write((u1, p), t)

@@ -1,0 +1,267 @@
+"""The load-path driver: Newton (PETSc SNES) along the user's load path.
+
+The user passes a function of pseudo-time ``t ∈ (0, 1]`` that updates their
+own Constants and Functions — Dirichlet values, tractions, body forces, a
+rigid obstacle's position (``obstacle.move_to``). Each step is solved by SNES
+(options prefix ``dolfinx_mortar_`` unless told otherwise, plus the
+``petsc_options`` given); a step that fails is halved and retried, cut steps
+regrow after successes, and after too many failures
+:class:`~dolfinx_mortar.solver.convergence.ContactDivergenceError` names every
+attempt's cause with its residual history. Converged steps go to XDMF.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Optional, Union
+
+import numpy as np
+from petsc4py import PETSc
+
+from dolfinx_mortar.input_checks import unused_petsc_options
+from dolfinx_mortar.io.contact_output import ContactOutput
+from dolfinx_mortar.solver.convergence import (ContactDivergenceError, EquilibriumTest,
+                                               FailedAttempt, describe_failure)
+from dolfinx_mortar.solver.load_stepping import LoadStepper
+from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
+from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
+
+
+@dataclass
+class StepResult:
+    """One converged load step."""
+
+    load_factor: float
+    newton_iterations: int
+    residuals: list
+    wall_time: float
+    active_nodes: int
+
+
+@dataclass
+class SolveResult:
+    """All converged steps."""
+
+    steps: list = field(default_factory=list)
+
+    @property
+    def newton_iterations(self) -> int:
+        return sum(s.newton_iterations for s in self.steps)
+
+
+class LoadPathSolver:
+    """Solves a :class:`NonlinearContactProblem` along a load path.
+
+    Parameters
+    ----------
+    problem
+        The user's model with its contact terms.
+    petsc_options
+        PETSc options for this solver's SNES, KSP and PC, without the prefix
+        (``{"snes_max_it": 60, "ksp_type": "preonly"}``); they take precedence
+        over the options database for this solver and are removed from it
+        after each solve.
+    prefix
+        The options prefix (command-line options ``-<prefix>snes_…`` apply).
+    """
+
+    def __init__(self, problem: NonlinearContactProblem,
+                 petsc_options: Optional[dict] = None, prefix: str = "dolfinx_mortar_"):
+        self.problem = problem
+        self.prefix = prefix
+        self.petsc_options = dict(petsc_options or {})
+        self.comm = problem.u.function_space.mesh.comm
+        self.equilibrium = EquilibriumTest()
+        self._options_checked = False
+        #: wall time (s) inside SNES solves, callbacks included (accumulated)
+        self.timings: dict[str, float] = {}
+
+    @property
+    def contacts(self):
+        return self.problem.contacts
+
+    def create_snes(self) -> PETSc.SNES:
+        """A SNES with the problem's callbacks and the options of this solver."""
+        opts = PETSc.Options()
+        defaults = dict(DEFAULT_OPTIONS)
+        if any(term.basis_configuration == "current" for term in self.contacts):
+            # With the bases on the current surface the first full Newton steps
+            # of a slide diverged to NaN (basic); backtracking converged.
+            defaults["snes_linesearch_type"] = "bt"
+        for key, value in defaults.items():
+            if not opts.hasName(self.prefix + key) and key not in self.petsc_options:
+                opts[self.prefix + key] = value
+        snes = PETSc.SNES().create(self.comm)
+        snes.setOptionsPrefix(self.prefix)
+        self.problem.configure_snes(snes)
+        snes.setConvergenceHistory()
+        snes.setFromOptions()
+        snes.setConvergenceTest(self.equilibrium)
+        self.problem.configure_ksp(snes.getKSP())
+        return snes
+
+    def solve(self, update: Callable[[float], None], load_steps: int = 1,
+              output: Optional[Union[str, Path]] = None, max_cuts: int = 5,
+              progress: bool = False,
+              on_step: Optional[Callable[[StepResult], None]] = None) -> SolveResult:
+        """Follow the load path from t = 0 to 1 in ``load_steps`` steps.
+
+        Parameters
+        ----------
+        update
+            ``update(t)`` sets the user's Constants, Functions and obstacles to
+            pseudo-time t (it is called again with a smaller t after a cut).
+        load_steps
+            Equal steps when nothing fails (a positive integer).
+        output
+            XDMF path of every converged step (:mod:`dolfinx_mortar.io.contact_output`).
+        max_cuts
+            Failures in a row before :class:`ContactDivergenceError`.
+        progress
+            A tqdm progress bar on rank 0.
+        on_step
+            Called with each converged step's :class:`StepResult`.
+        """
+        stepper = LoadStepper(load_steps, max_cuts)
+        u = self.problem.u
+        if not np.all(np.isfinite(u.x.array)):
+            raise ValueError("the displacement contains NaN or infinite values")
+        writer = ContactOutput(Path(output), u, self.contacts) if output is not None else None
+        result = SolveResult()
+        failures: list[FailedAttempt] = []
+        bar = None
+        if progress and self.comm.rank == 0:
+            from tqdm import tqdm
+            bar = tqdm(total=stepper.load_steps, desc="load steps", unit="step")
+        with TemporaryOptions(self.prefix, self.petsc_options):
+            self._options_checked = False
+            snes = self.create_snes()
+            try:
+                while not stepper.done:
+                    target = stepper.target()
+                    update(target)
+                    if any([term.begin_step() for term in self.contacts]):
+                        snes.setJacobian(lambda _s, x, A, P: self.problem.J(x, A),
+                                         self.problem.refresh_matrix())
+                    saved = u.vector.copy()
+                    clock = time.perf_counter()
+                    x = u.vector.copy()
+                    reason, history, iterations, cause = self.newton_step(snes, x)
+                    if reason <= 0:
+                        failures.append(FailedAttempt(target, reason, history, cause))
+                        stepper.failed()
+                        if stepper.exhausted:
+                            raise ContactDivergenceError(target, failures)
+                        saved.copy(u.vector)
+                        u.x.scatter_forward()
+                        continue
+                    failures = []
+                    x.copy(u.vector)
+                    u.x.scatter_forward()
+                    states = [term.evaluate() for term in self.contacts]
+                    active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
+                    step = StepResult(target, iterations, history,
+                                      time.perf_counter() - clock, active)
+                    result.steps.append(step)
+                    before = stepper.fraction_of_steps
+                    stepper.succeeded()
+                    if bar is not None:
+                        bar.update(stepper.fraction_of_steps - before)
+                    for term in self.contacts:
+                        term.warn_if_slipped_too_far()
+                    if writer is not None:
+                        writer.write(target, states)
+                    if on_step is not None:
+                        on_step(step)
+            finally:
+                if bar is not None:
+                    bar.close()
+                snes.destroy()
+        return result
+
+    def newton_step(self, snes: PETSc.SNES, x: PETSc.Vec) -> tuple[int, list, int, str]:
+        """One load step's Newton solve from x: SNES reason, residuals, iterations
+        and, if it failed, what stopped it (in words).
+
+        The step is accepted when ``‖R‖ ≤ rtol·F``
+        (:class:`~dolfinx_mortar.solver.convergence.EquilibriumTest`) with F the
+        residual norm at x before the gap-closing start: the force out of
+        balance when the step starts, whatever Newton starts from.
+
+        With ``basis_configuration="current"`` the step is first solved with
+        the surface frozen where the step starts (the "previous" model:
+        piecewise linear, robust), then on the current surface with the exact
+        Jacobian. Started from the current surface directly, the first
+        iterations overshoot to pressures whose geometric stiffness is larger
+        than the bulk's, and Newton cycled or diverged (Hertz 2D).
+        """
+        history: list = []
+        iterations = 0
+        b = self.problem.vector()
+        self.problem.F(x, b)
+        self.equilibrium.start(b.norm())
+        two_phase = any(term.basis_configuration == "current" for term in self.contacts)
+        for frozen in ([True, False] if two_phase else [False]):
+            reason = self._solve_phase(snes, x, frozen)
+            history += list(snes.getConvergenceHistory()[0])
+            iterations += snes.getIterationNumber()
+            if reason <= 0:
+                return reason, history, iterations, describe_failure(snes, self.equilibrium)
+        return reason, history, iterations, ""
+
+    def _solve_phase(self, snes: PETSc.SNES, x: PETSc.Vec, frozen: bool) -> int:
+        from contextlib import ExitStack
+        with ExitStack() as stack:
+            if frozen:
+                for term in self.contacts:
+                    stack.enter_context(term.frozen())
+            self.close_gaps(snes, x)
+            snes.setConvergenceHistory(reset=True)
+            clock = time.perf_counter()
+            snes.solve(None, x)
+            self.timings["snes_solve"] = (self.timings.get("snes_solve", 0.0)
+                                          + time.perf_counter() - clock)
+        if not self._options_checked:
+            # every option is read by the first solve: once per solve() is enough
+            self._check_petsc_options()
+            self._options_checked = True
+        return snes.getConvergedReason()
+
+    def close_gaps(self, snes: PETSc.SNES, x: PETSc.Vec) -> None:
+        """Move x into contact when nothing touches yet (a better Newton start).
+
+        With positive mortar functions a body that touches at a point has
+        d̄ < 0 at every node, no contact force, and Newton's linear model —
+        stiff only from the current gap on — creeps towards the obstacle by
+        F/(εA) per iteration. This step solves the linear model in which the
+        nodes near contact carry the force ``ω(d̄ + GΔu)``, which closes their
+        gaps: it overshoots by about the largest of those gaps (a tenth of an
+        element), which Newton then takes back. It changes only where Newton
+        starts, not the solution.
+        """
+        b = self.problem.vector()
+        self.problem.F(x, b)
+        pulls = [term.gap_closing_force() for term in self.contacts]
+        if all(p is None for p in pulls):
+            return
+        A = self.problem.matrix()
+        self.problem.J(x, A)
+        rhs = b.copy()
+        for pull in pulls:
+            if pull is not None:
+                rhs.axpy(1.0, pull)
+        ksp = snes.getKSP()
+        ksp.setOperators(A)
+        dx = rhs.duplicate()
+        ksp.solve(rhs, dx)
+        if ksp.getConvergedReason() > 0:
+            x.axpy(-1.0, dx)
+
+    def _check_petsc_options(self) -> None:
+        """Refuse options under the prefix that no PETSc object read (misspelled)."""
+        unused = unused_petsc_options(self.prefix, ignore=DEFAULT_OPTIONS)
+        if unused:
+            raise ValueError(f"PETSc option(s) {', '.join(unused)} were set but not used by "
+                             f"any solver of this problem: misspelled, or meant for another "
+                             f"prefix? (options prefix '{self.prefix}')")

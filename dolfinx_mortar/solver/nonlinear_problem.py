@@ -1,0 +1,184 @@
+"""The user's nonlinear model plus contact, in the image of
+:class:`dolfinx.fem.petsc.NonlinearProblem`.
+
+The residual form ``F(u; v)`` is the user's: any material law, body forces,
+several subdomains, tractions scaled by their own Constants. The contact
+terms add their residual and Jacobian; :meth:`NonlinearContactProblem.F` and
+:meth:`NonlinearContactProblem.J` are what PETSc SNES
+(:meth:`NonlinearContactProblem.configure_snes`) or DOLFINx's ``NewtonSolver``
+call::
+
+    problem = NonlinearContactProblem(F, u, contact, bcs)
+    solver = dolfinx.nls.petsc.NewtonSolver(comm, problem)
+    solver.setJ(problem.J, problem.matrix())    # the pattern with the contact's
+    solver.solve(u)
+"""
+from __future__ import annotations
+
+import time
+from typing import Optional, Sequence, Union
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from dolfinx.fem import petsc as fem_petsc
+from petsc4py import PETSc
+
+from dolfinx_mortar.contact.term import ContactTerm
+
+
+class NonlinearContactProblem:
+    """Residual ``F(u; v) + R_c(u)`` and its exact Jacobian.
+
+    Parameters
+    ----------
+    F
+        The user's residual form (a UFL form, linear in the test function).
+    u
+        The unknown Function (the displacement the contact terms are built on).
+    contact
+        One contact term or several (:class:`~dolfinx_mortar.contact.term.ContactTerm`).
+    bcs
+        Dirichlet conditions; the contact terms skip their dofs.
+    J
+        The Jacobian form of F (default: its Gateaux derivative in u).
+    form_compiler_params, jit_params
+        Passed to :func:`dolfinx.fem.form`.
+    """
+
+    def __init__(self, F: ufl.Form, u: fem.Function,
+                 contact: Union[ContactTerm, Sequence[ContactTerm]],
+                 bcs: Sequence[fem.DirichletBCMetaClass] = (), J: Optional[ufl.Form] = None,
+                 form_compiler_params: Optional[dict] = None, jit_params: Optional[dict] = None):
+        self.u = u
+        self.bcs = list(bcs)
+        self.contacts = [contact] if isinstance(contact, ContactTerm) else list(contact)
+        if not self.contacts:
+            raise ValueError("no contact term: use dolfinx.fem.petsc.NonlinearProblem")
+        for term in self.contacts:
+            if term.u is not u:
+                raise ValueError("every contact term must be built on the problem's u")
+        if sum(term.augmented for term in self.contacts) > 1 or (
+                len(self.contacts) > 1 and any(term.augmented for term in self.contacts)):
+            raise NotImplementedError("a GLS kind (augmented Newton step) must be the only "
+                                      "contact term of a problem")
+        fc = form_compiler_params or {}
+        jit = jit_params or {}
+        self.L = fem.form(F, form_compiler_params=fc, jit_params=jit)
+        if J is None:
+            J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
+        self.a = fem.form(J, form_compiler_params=fc, jit_params=jit)
+        self._A: Optional[PETSc.Mat] = None
+        self._b: Optional[PETSc.Vec] = None
+        #: wall times of the bulk assembly, seconds (the contact's are in each term's timings)
+        self.timings: dict[str, float] = {}
+
+    # -- what NewtonSolver and SNES call -----------------------------------------------
+    def form(self, x: PETSc.Vec) -> None:
+        """Bring x's ghosts up to date (DOLFINx's NewtonSolver calls this first)."""
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+    def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        """Assemble the residual at ``x`` into ``b`` (the contact states are updated)."""
+        clock = time.perf_counter()
+        if x.handle != self.u.vector.handle:
+            x.copy(self.u.vector)
+        self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with b.localForm() as local:
+            local.set(0.0)
+        fem_petsc.assemble_vector(b, self.L)
+        # x0 must carry current ghost values: SNES updates only x's owned
+        # entries, and a stale prescribed value on a ghost dof next to the
+        # partition boundary acts as a spurious force (a block pressed by u_y
+        # on a face the partition crosses gave 0.2% … 8× wrong forces)
+        fem_petsc.apply_lifting(b, [self.a], [self.bcs], x0=[self.u.vector], scale=-1.0)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self._add("bulk_residual", clock)
+        for term in self.contacts:
+            term.assemble_residual(b, self.bcs)
+        fem_petsc.set_bc(b, self.bcs, self.u.vector, -1.0)
+
+    def J(self, x: PETSc.Vec, A: PETSc.Mat) -> None:
+        """Assemble the Jacobian at the state of the last :meth:`F` into ``A``.
+
+        A must hold the contact's pattern (:meth:`matrix`). GLS kinds: A gets
+        the bulk only, and the KSP applies the exact step
+        (:meth:`configure_ksp`).
+        """
+        clock = time.perf_counter()
+        A.zeroEntries()
+        fem_petsc.assemble_matrix(A, self.a, self.bcs)
+        A.assemble()
+        self._add("bulk_jacobian", clock)
+        for term in self.contacts:
+            term.assemble_jacobian(A, self.bcs)
+
+    def matrix(self) -> PETSc.Mat:
+        """The Jacobian matrix with the bulk and contact patterns (made once;
+        :meth:`refresh_matrix` after a contact term rebuilt its bases)."""
+        if self._A is None:
+            self._A = self.contacts[0].create_matrix(self.a, self.bcs)
+            for term in self.contacts[1:]:
+                other = term.create_matrix(self.a, self.bcs)
+                self._A.axpy(1.0, other, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        return self._A
+
+    def refresh_matrix(self) -> PETSc.Mat:
+        """A new :meth:`matrix` (the contact pattern changed)."""
+        if self._A is not None:
+            self._A.destroy()
+        self._A = None
+        return self.matrix()
+
+    def vector(self) -> PETSc.Vec:
+        """A residual vector."""
+        if self._b is None:
+            self._b = fem_petsc.create_vector(self.L)
+        return self._b
+
+    # -- PETSc SNES --------------------------------------------------------------------
+    def configure_ksp(self, ksp: PETSc.KSP) -> None:
+        """What the contact terms need of the linear solver (GLS: the exact
+        augmented step as a python PC); call after ``setFromOptions``."""
+        for term in self.contacts:
+            term.configure_ksp(ksp)
+
+    def configure_snes(self, snes: PETSc.SNES) -> None:
+        """Give ``snes`` the residual, the Jacobian and its matrix."""
+        snes.setFunction(lambda _snes, x, b: self.F(x, b), self.vector())
+        snes.setJacobian(lambda _snes, x, A, P: self.J(x, A), self.matrix())
+
+    def _add(self, name: str, since: float) -> None:
+        self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
+
+
+def reaction_force(problem: NonlinearContactProblem, facet_tags, tag: int) -> np.ndarray:
+    """The force that the supports on the facets ``tag`` exert on the body, a
+    gdim-vector summed over all ranks.
+
+    It is the residual ``F(u) + R_c(u)`` without boundary conditions, summed
+    over the dofs of those facets: zero on free dofs at equilibrium, the
+    support's force on prescribed ones (with a rigid obstacle pressing a
+    block onto a fixed base, the base's reaction is minus the obstacle's
+    contact force).
+    """
+    u = problem.u
+    V = u.function_space
+    mesh = V.mesh
+    facets = facet_tags.find(tag)
+    if mesh.comm.allreduce(len(facets)) == 0:
+        raise ValueError(f"facet tag {tag} marks no facets")
+    b = fem_petsc.create_vector(problem.L)
+    with b.localForm() as local:
+        local.set(0.0)
+    u.x.scatter_forward()
+    fem_petsc.assemble_vector(b, problem.L)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    for term in problem.contacts:
+        b.axpy(1.0, term.evaluate().residual)
+    blocks = fem.locate_dofs_topological(V, mesh.topology.dim - 1, facets)
+    owned = blocks[blocks < V.dofmap.index_map.size_local]
+    bs = V.dofmap.index_map_bs
+    local = b.array_r.reshape(-1, bs)[owned].sum(axis=0)
+    b.destroy()
+    return np.asarray(mesh.comm.allreduce(local))

@@ -1,0 +1,72 @@
+"""The solver's default PETSc options and options given per solver.
+
+The defaults are set under the prefix unless the options database has them
+(so the command line wins); options given to a solver
+(``petsc_options={...}``) win over both and are removed again after its
+solve, so that they do not leak into the next solver with the same prefix.
+"""
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+from petsc4py import PETSc
+
+#: PETSc options set unless the options database already has them
+DEFAULT_OPTIONS = {
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "basic",
+    # relative to the out-of-balance force where the step starts
+    # (dolfinx_mortar.solver.convergence.EquilibriumTest)
+    "snes_rtol": 1e-11,
+    # absolute residuals depend on the units: rely on the relative test
+    "snes_atol": 1e-15,
+    # a Newton step at round-off size ends the iteration, as a failure unless
+    # the residual test holds
+    "snes_stol": 1e-13,
+    "snes_max_it": 40,
+    # the first step of a contact problem often overshoots into the obstacle
+    # before the active set settles: do not call that divergence
+    "snes_divergence_tolerance": -1,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+    # MUMPS sizes its workspace from the analysis; parallel pivoting can exceed
+    # it (INFOG(1) = -9). 100% extra costs memory only.
+    "mat_mumps_icntl_14": 100,
+}
+
+
+def _as_option(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return "" if value is None else str(value)
+
+
+class TemporaryOptions:
+    """Options under a prefix for the duration of a ``with`` block; what they
+    replaced (or their absence) is restored after it."""
+
+    def __init__(self, prefix: str, options: Mapping[str, Any]):
+        for key in options:
+            if not isinstance(key, str) or key.startswith("-") or key.startswith(prefix):
+                raise ValueError(f"petsc_options keys are option names without '-' and "
+                                 f"without the prefix '{prefix}', got {key!r}")
+        self.prefix, self.options = prefix, dict(options)
+        self._saved: dict[str, Any] = {}
+
+    def __enter__(self) -> "TemporaryOptions":
+        db = PETSc.Options()
+        for key, value in self.options.items():
+            name = self.prefix + key
+            self._saved[name] = db.getString(name) if db.hasName(name) else None
+            db[name] = _as_option(value)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        db = PETSc.Options()
+        for name, old in self._saved.items():
+            if old is None:
+                db.delValue(name)
+            else:
+                db[name] = old
+        self._saved = {}

@@ -1,0 +1,229 @@
+"""Contact as a term in the user's own DOLFINx model (public API only).
+
+The user's residual form (linear or neo-Hookean, body forces), their
+Dirichlet conditions and load path; the contact term, the nonlinear problem
+(driven by DOLFINx's NewtonSolver or the library's load-path solver), moving
+obstacles, the contact resultant and the reactions.
+"""
+from __future__ import annotations
+
+import importlib.util
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem
+from dolfinx.nls.petsc import NewtonSolver
+from meshes import rectangle
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar import (ContactDivergenceError, ContactProblem, ContactTerm, KIND_NAMES,
+                            LoadPathSolver, NonlinearContactProblem, RigidPlane, RigidSphere,
+                            reaction_force)
+from dolfinx_mortar.solver.elastic import linear_elastic_residual
+
+BOTTOM, TOP, LEFT = 1, 2, 3
+E, NU, H = 1.0, 0.3, 0.5
+E_PLANE = E / (1 - NU ** 2)   # plane strain, free sideways
+
+
+def neo_hookean_residual(u: fem.Function, E: float, nu: float, body_force) -> ufl.Form:
+    """Compressible neo-Hookean (plane strain in 2D) with a body force."""
+    v = ufl.TestFunction(u.function_space)
+    d = len(u)
+    F = ufl.Identity(d) + ufl.grad(u)
+    J = ufl.det(F)
+    mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+    psi = mu / 2 * (ufl.tr(F.T * F) - d) - mu * ufl.ln(J) + lmbda / 2 * ufl.ln(J) ** 2
+    energy = psi * ufl.dx - ufl.dot(body_force, u) * ufl.dx
+    return ufl.derivative(energy, u, v)
+
+
+def block(n=(8, 4), degree=1):
+    domain, tags = rectangle(MPI.COMM_WORLD, 0.0, H, n, bottom=BOTTOM, top=TOP, left=LEFT)
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", degree))
+    return domain, tags, V
+
+
+def dirichlet(V, tags, tag, component, value):
+    dofs = fem.locate_dofs_topological(V.sub(component), 1, tags.find(tag))
+    return fem.dirichletbc(PETSc.ScalarType(value), dofs, V.sub(component))
+
+
+def jacobian_error(problem: NonlinearContactProblem, seed: int = 3) -> float:
+    """Central differences of problem.F against problem.J at the present u."""
+    x0 = problem.u.vector.copy()
+    A = problem.matrix()
+    b = problem.vector().duplicate()
+    problem.F(x0, b)
+    problem.J(x0, A)
+    problem.J(x0, A)   # "current": exact once the active set is the previous call's
+    dx = x0.duplicate()
+    dx.array[:] = np.random.default_rng(seed + MPI.COMM_WORLD.rank).normal(size=dx.array.shape)
+    fem.petsc.set_bc(dx, problem.bcs, scale=0.0)
+    Jdx = b.duplicate()
+    A.mult(dx, Jdx)
+    h = 1e-6 / dx.norm()
+    residuals = []
+    for sign in (1, -1):
+        x = x0.copy()
+        x.axpy(sign * h, dx)
+        r = b.duplicate()
+        problem.F(x, r)
+        residuals.append(r)
+    fd = residuals[0] - residuals[1]
+    fd.scale(1 / (2 * h))
+    fd.axpy(-1.0, Jdx)
+    x0.copy(problem.u.vector)
+    problem.u.x.scatter_forward()
+    return fd.norm() / Jdx.norm()
+
+
+@pytest.mark.parametrize("configuration", ["initial", "current"])
+@pytest.mark.parametrize("kind", ["LmLS*", "LcLS"])
+def test_neo_hookean_user_form_has_the_exact_jacobian(kind, configuration):
+    """A nonlinear material with a body force, written by the user in UFL, plus
+    the contact term against a rigid disk: J is the derivative of F."""
+    domain, tags, V = block(n=(6, 3))
+    u = fem.Function(V)
+    g = fem.Constant(domain, PETSc.ScalarType((0.0, -0.05)))
+    F = neo_hookean_residual(u, E, NU, g)
+    contact = ContactTerm(u, tags, BOTTOM, obstacle=RigidSphere([0.5, -2.0], 2.0), kind=kind,
+                          penalty=50.0, basis_configuration=configuration)
+    bcs = [dirichlet(V, tags, LEFT, 0, 0.0), dirichlet(V, tags, TOP, 1, -0.01)]
+    problem = NonlinearContactProblem(F, u, contact, bcs)
+    u.interpolate(lambda x: np.vstack([0.02 * x[1] + 0.01 * x[0] ** 2,
+                                       -0.004 + 0.004 * x[0] ** 2 - 0.02 * x[1]]))
+    # a state that meets the BCs, as Newton's iterates do (DOLFINx's lifting
+    # of a nonlinear form is only differentiated there)
+    fem.petsc.set_bc(u.vector, bcs)
+    u.x.scatter_forward()
+    p = contact.nodal_pressures()
+    n = contact.slave.layout.num_owned
+    assert domain.comm.allreduce(int(np.sum(p[:n] > 0))) > 0   # partly in contact
+    assert domain.comm.allreduce(int(np.sum(p[:n] == 0))) > 0
+    assert jacobian_error(problem) < 1e-7
+
+
+def uniform_pressure(delta: float, penalty: float) -> float:
+    """The block pushed by δ onto its fixed top: p = δ/(H/E' + 1/ε) (penalty compliance)."""
+    return delta / (H / E_PLANE + 1 / penalty)
+
+
+@pytest.mark.parametrize("kind", KIND_NAMES)
+def test_dolfinx_newton_solver_drives_the_contact_problem(kind):
+    """DOLFINx's own NewtonSolver with the contact problem: the plane moved up by
+    δ (a moving obstacle) presses the block onto its fixed top."""
+    domain, tags, V = block()
+    u = fem.Function(V)
+    plane = RigidPlane([0.0, 0.0], [0.0, 1.0])
+    penalty, delta = 1e3, 0.01
+    contact = ContactTerm(u, tags, BOTTOM, obstacle=plane, kind=kind, penalty=penalty)
+    bcs = [dirichlet(V, tags, LEFT, 0, 0.0), dirichlet(V, tags, TOP, 1, 0.0)]
+    problem = NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact, bcs)
+    plane.move_to([0.0, delta])
+    solver = NewtonSolver(domain.comm, problem)
+    solver.setJ(problem.J, problem.matrix())
+    problem.configure_ksp(solver.krylov_solver)
+    solver.krylov_solver.setType("preonly")
+    solver.krylov_solver.getPC().setType("lu") if not contact.augmented else None
+    solver.rtol, solver.atol = 1e-12, 1e-14
+    iterations, converged = solver.solve(u)
+    assert converged
+    p_exact = uniform_pressure(delta, penalty)
+    p = contact.nodal_pressures()
+    on = np.zeros(len(p), dtype=bool)
+    on[contact.slave.cells] = True
+    on[contact.slave.layout.num_owned:] = False
+    error = domain.comm.allreduce(float(np.max(np.abs(p[on] - p_exact), initial=0.0)),
+                                  op=MPI.MAX)
+    assert error < 1e-8 * p_exact
+    # the resultant on the slave pushes up; the top's support pulls down as much
+    force = contact.contact_force()
+    assert force[1] == pytest.approx(p_exact, rel=1e-8) and abs(force[0]) < 1e-10 * p_exact
+    assert contact.normal_force() == pytest.approx(p_exact, rel=1e-8)
+    assert reaction_force(problem, tags, TOP)[1] == pytest.approx(-p_exact, rel=1e-8)
+
+
+def test_load_path_moves_the_obstacle_and_takes_petsc_options(tmp_path):
+    """The user's callback moves the obstacle along the load path; petsc_options
+    reach the solver and leave the options database afterwards."""
+    domain, tags, V = block()
+    u = fem.Function(V)
+    plane = RigidPlane([0.0, 0.0], [0.0, 1.0])
+    contact = ContactTerm(u, tags, BOTTOM, obstacle=plane, kind="LcLS*", penalty=1e3)
+    bcs = [dirichlet(V, tags, LEFT, 0, 0.0), dirichlet(V, tags, TOP, 1, 0.0)]
+    problem = NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact, bcs)
+    solver = LoadPathSolver(problem, petsc_options={"snes_max_it": 7}, prefix="open_path_")
+    seen = []
+    result = solver.solve(lambda t: plane.move_to([0.0, 0.01 * t]), load_steps=3,
+                          output=tmp_path / "path.xdmf",
+                          on_step=lambda step: seen.append(contact.contact_force()[1]))
+    assert [s.load_factor for s in result.steps] == pytest.approx([1 / 3, 2 / 3, 1.0])
+    p = [uniform_pressure(0.01 * t, 1e3) for t in (1 / 3, 2 / 3, 1.0)]
+    assert seen == pytest.approx(p, rel=1e-8)
+    assert not PETSc.Options().hasName("open_path_snes_max_it")
+    if domain.comm.rank == 0:
+        assert (tmp_path / "path.xdmf").exists() and (tmp_path / "path_slave.xdmf").exists()
+    # an option no solver reads is named, not ignored
+    misspelled = LoadPathSolver(problem, petsc_options={"snes_max_itt": 7}, prefix="open_bad_")
+    with pytest.raises(ValueError, match="snes_max_itt"):
+        misspelled.solve(lambda t: plane.move_to([0.0, 0.01]), load_steps=1)
+    # and a limit that cannot be met fails with the history
+    strict = LoadPathSolver(problem, petsc_options={"snes_max_it": 0}, prefix="open_zero_")
+    u.x.array[:] = 0.0
+    with pytest.raises(ContactDivergenceError):
+        strict.solve(lambda t: plane.move_to([0.0, 0.02 * t]), load_steps=1, max_cuts=1)
+
+
+def load_demo(name: str):
+    path = Path(__file__).resolve().parents[1] / "demos" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("configuration", ["initial", "previous"])
+def test_initial_configuration_warns_past_an_element_of_slip(configuration):
+    """Two blocks, the upper one slid by about three element lengths: the frozen
+    "initial" segmentation is warned about, the rebuilt "previous" one is not."""
+    demo = load_demo("patch_test")
+    domain, tags = demo.build_mesh(2, 0.09, 0.14, 1, MPI.COMM_WORLD)
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
+                             nu=0.3, kind="LcLS*", penalty=1e3,
+                             basis_configuration=configuration,
+                             fixed={demo.BOTTOM: {0: 0.0, 1: 0.0},
+                                    demo.TOP: {0: 0.3, 1: -0.002}})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        problem.solve(load_steps=3)
+    slipped = [w for w in caught if "slipped" in str(w.message)]
+    assert len(slipped) == (1 if configuration == "initial" else 0)
+    assert problem.contact.slip() > (1.0 if configuration == "initial" else -1.0)
+
+
+def test_contact_term_refuses_bad_input():
+    domain, tags, V = block(n=(4, 2))
+    u = fem.Function(V)
+    with pytest.raises(TypeError, match="Function"):
+        ContactTerm(V, tags, BOTTOM, obstacle=RigidPlane([0, 0], [0, 1]), penalty=1.0)
+    with pytest.raises(ValueError, match="penalty"):
+        ContactTerm(u, tags, BOTTOM, obstacle=RigidPlane([0, 0], [0, 1]), penalty=-1.0)
+    with pytest.raises(ValueError, match="exactly one"):
+        ContactTerm(u, tags, BOTTOM, penalty=1.0)
+    with pytest.raises(ValueError, match="marks no facets"):
+        ContactTerm(u, tags, 99, obstacle=RigidPlane([0, 0], [0, 1]), penalty=1.0)
+    with pytest.raises(ValueError, match="displacement"):
+        RigidPlane([0, 0], [0, 1]).move_to([0.0, np.nan])
+    contact = ContactTerm(u, tags, BOTTOM, obstacle=RigidPlane([0, 0], [0, 1]), penalty=1.0)
+    other = fem.Function(V)
+    with pytest.raises(ValueError, match="problem's u"):
+        NonlinearContactProblem(linear_elastic_residual(other, E, NU), other, contact)
+    with pytest.raises(ValueError, match="without '-'"):
+        LoadPathSolver(NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact),
+                       petsc_options={"-snes_max_it": 3}).solve(lambda t: None)
