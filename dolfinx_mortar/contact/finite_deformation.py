@@ -267,6 +267,10 @@ class CurrentSurfaceGap(GapModelBase):
         K.axpy(1.0, K_el, structure=Different)
         return K
 
+    def pattern(self, state: ContactState) -> PETSc.Mat:
+        """The exact Jacobian with every node active: every entry it may have."""
+        return self.jacobian(state, np.ones_like(state.gaps), None)
+
     def energy(self, u_nodes: FloatArray) -> float:
         """Π_c summed over all ranks (for checking the residual)."""
         e = self._elements(u_nodes)

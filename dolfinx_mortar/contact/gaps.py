@@ -162,9 +162,13 @@ class GapModelBase:
             K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return K
 
-    def pattern(self, state: ContactState, mask: Optional[PETSc.Vec]) -> PETSc.Mat:
-        """A matrix with every entry the contact stiffness may have."""
-        return self.jacobian(state, np.ones_like(self.weights), mask)
+    def pattern(self, state: ContactState) -> PETSc.Mat:
+        """A matrix with every entry the contact stiffness may have (``GᵀG``
+        and the curvature: the pointwise ``GᵀG⁺`` and the nodal fallback are in it)."""
+        K = state.G.transposeMatMult(state.G)
+        if state.K_curv is not None:
+            K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        return K
 
     def nodal_force(self, values: FloatArray) -> FloatArray:
         """The nodal force f of ``R_c = Gᵀ f`` for nodal values ω⟨d̄⟩ (here: themselves)."""

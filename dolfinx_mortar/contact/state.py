@@ -69,6 +69,9 @@ class GapModel(Protocol):
                  geometric: bool = True) -> PETSc.Mat:
         """The contact stiffness with ``active`` (0/1 per node) as H(d̄)."""
 
+    def pattern(self, state: ContactState) -> PETSc.Mat:
+        """A matrix with every entry :meth:`jacobian` may have at this state."""
+
     def nodal_pressures(self, state: ContactState) -> FloatArray: ...
 
     def mortar_traction(self, state: ContactState) -> FloatArray: ...

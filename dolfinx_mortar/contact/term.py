@@ -286,8 +286,7 @@ class ContactTerm(ContactResults):
         if self.model.augmented:
             return A
         state = self.state or self.update(bcs)
-        K = self.model.jacobian(state, np.ones_like(self.model.weights), self.mask(bcs))
-        A.axpy(1.0, K, structure=DIFFERENT)
+        A.axpy(1.0, self.model.pattern(state), structure=DIFFERENT)
         if self.moving_pattern or self.basis_configuration == "previous":
             # the pairs, and so the pattern, change with u: new entries are
             # allocated as they come
