@@ -21,7 +21,7 @@ use, so that the bases and kernels work without it.
 """
 from importlib import import_module
 
-from dolfinx_mortar import kinds
+from dolfinx_mortar import kinds, quiet_logs
 from dolfinx_mortar.bases import basis
 from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import KIND_NAMES, parse_kind
@@ -42,6 +42,8 @@ _LAZY = {
 __all__ = ["basis", "kinds", "lagrange", "nurbs", "MortarBasis", "KIND_NAMES",
            "parse_kind", *_LAZY]
 __version__ = "0.2.0"
+
+quiet_logs.install()
 
 
 def __getattr__(name: str):

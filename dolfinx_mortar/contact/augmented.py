@@ -40,6 +40,18 @@ class AugmentedNewtonStep:
         #: wall time of the factorizations (a linear-solve cost spent in the Jacobian callback)
         self.factorization_time = 0.0
 
+    def update_from(self, A: PETSc.Mat, state, model, active: FloatArray) -> None:
+        """:meth:`update` from the bulk matrix ``A`` and a GLS model's state
+        (:class:`~dolfinx_mortar.contact.global_gap.GlobalGap`); ``active`` as H(d̄).
+        The pointwise set puts Ĝ⁺ in the last row while anything penetrates."""
+        K = A.copy()
+        if state.K_curv is not None:
+            K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        G_right, weights = state.G, model.weights * active
+        if state.gaps_plus is not None and model.inner.any_penetration(state.gaps_plus):
+            G_right, weights = state.G_plus, model.weights
+        self.update(K, state.G, weights, model.mass.matrix, G_right, model.surface_rows)
+
     def update(self, K: PETSc.Mat, G: PETSc.Mat, weights: FloatArray, L: PETSc.Mat,
                G_linearized: Optional[PETSc.Mat] = None,
                surface: Optional[npt.NDArray[np.int64]] = None) -> None:

@@ -75,3 +75,6 @@ class GapModel(Protocol):
     def nodal_pressures(self, state: ContactState) -> FloatArray: ...
 
     def mortar_traction(self, state: ContactState) -> FloatArray: ...
+
+    def nodal_force(self, values: FloatArray) -> FloatArray:
+        """The nodal force f of ``R_c = Gᵀ f`` for nodal values ω⟨d̄⟩."""

@@ -29,6 +29,7 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.contact.active_set import gap_closing_force, stiffened_nodes
 from dolfinx_mortar.contact.augmented import AugmentedNewtonStep
 from dolfinx_mortar.contact.models import ContactOptions, current_model, frozen_model, moved
 from dolfinx_mortar.contact.obstacles import RigidObstacle
@@ -225,7 +226,9 @@ class ContactTerm(ContactResults):
         mask = self.mask(bcs)
         state = self.state
         if self.model.augmented:
-            self._prepare_augmented(A, state)
+            if self._augmented is None:
+                self._augmented = AugmentedNewtonStep(self.mesh.comm, self.augmented_prefix)
+            self._augmented.update_from(A, state, self.model, self.active_nodes_mask(state))
         else:
             settled = True
             active = self.active_nodes_mask(state)
@@ -244,19 +247,6 @@ class ContactTerm(ContactResults):
             A.axpy(1.0, K, structure=SUBSET)
             A.assemble()
         self._add("jacobian", clock)
-
-    def _prepare_augmented(self, A: PETSc.Mat, state: ContactState) -> None:
-        model = self.model
-        K = A.copy()
-        if state.K_curv is not None:
-            K.axpy(1.0, state.K_curv, structure=DIFFERENT)
-        G_right, weights = state.G, model.weights * self.active_nodes_mask(state)
-        if state.gaps_plus is not None and model.inner.any_penetration(state.gaps_plus):
-            G_right, weights = state.G_plus, model.weights
-        if self._augmented is None:
-            self._augmented = AugmentedNewtonStep(self.mesh.comm, self.augmented_prefix)
-        self._augmented.update(K, state.G, weights, model.mass.matrix, G_right,
-                               model.surface_rows)
 
     @property
     def augmented_step(self) -> Optional[AugmentedNewtonStep]:
@@ -294,42 +284,14 @@ class ContactTerm(ContactResults):
         return A
 
     def active_nodes_mask(self, state: ContactState) -> FloatArray:
-        """Nodes that get contact stiffness (H(d̄) as 0/1).
-
-        The generalized derivative of ⟨·⟩ at 0 is taken as 1, so touching
-        nodes stiffen without pushing. If no node on any rank is active — a
-        body that only touches at a point, with positive mortar functions, has
-        d̄ < 0 everywhere — the covered nodes within a tenth of their element
-        length of contact get stiffness too: otherwise the rigid-body mode
-        that the contact must hold makes the Jacobian singular. Nodes with no
-        master below them have no gap and are never active.
-        """
-        covered = self.model.covered
-        active = covered & (state.gaps >= 0)
-        n = self.slave.layout.num_owned
-        if self.mesh.comm.allreduce(int(np.sum(active[:n]))) == 0:
-            length = np.power(np.maximum(self.model.basis.lumped_weights, 0.0),
-                              1.0 / self.slave.tdim)
-            active = covered & (state.gaps >= -0.1 * length)
-        return active.astype(np.float64)
+        """Nodes that get contact stiffness (H(d̄) as 0/1,
+        :func:`~dolfinx_mortar.contact.active_set.stiffened_nodes`)."""
+        return stiffened_nodes(self.model, state)
 
     def gap_closing_force(self) -> Optional[PETSc.Vec]:
-        """``Gᵀ f`` with ``f = ω d̄`` on the nodes near contact, when nothing touches
-        yet (else None): the pull that closes their gaps (a better Newton start,
-        :class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`)."""
-        state = self.state
-        n = self.slave.layout.num_owned
-        touching = (state.gaps_plus if state.gaps_plus is not None
-                    else np.where(self.model.covered, np.maximum(state.gaps, 0.0), 0.0))
-        if self.mesh.comm.allreduce(bool(np.any(touching[:n] != 0))):
-            return None
-        near = self.active_nodes_mask(state)
-        if self.mesh.comm.allreduce(int(np.sum(near[:n]))) == 0:
-            return None
-        force = self.model.nodal_force(self.model.weights * near * state.gaps)
-        pull = state.G.createVecRight()
-        state.G.multTranspose(self.slave.layout.vector(force), pull)
-        return pull
+        """The pull that closes the gaps near contact when nothing touches yet
+        (:func:`~dolfinx_mortar.contact.active_set.gap_closing_force`)."""
+        return gap_closing_force(self.model, self.state)
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
