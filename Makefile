@@ -14,7 +14,7 @@ export OMP_NUM_THREADS := 1
 DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 	python3-ffcx python3-petsc4py python3-mpi4py python3-gmsh pybind11-dev \
 	libeigen3-dev python3-pytest python3-matplotlib python3-scipy python3-tqdm \
-	python3-dev cmake g++ make libgtest-dev openmpi-bin libopenblas0-serial
+	python3-dev cmake g++ make libgtest-dev openmpi-bin libopenblas0-serial python3-h5py
 # libopenblas0-serial replaces the reference BLAS behind PETSc/MUMPS: 3.7x faster
 # factorizations on Hertz 3D (33 s -> 8.8 s), serial so it does not fight MPI ranks.
 

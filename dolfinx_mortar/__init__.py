@@ -32,6 +32,7 @@ _LAZY = {
     "NonlinearContactProblem": "dolfinx_mortar.solver.nonlinear_problem",
     "reaction_force": "dolfinx_mortar.solver.nonlinear_problem",
     "LoadPathSolver": "dolfinx_mortar.solver.load_path",
+    "read_xdmf_series": "dolfinx_mortar.io.read_series",
     "ContactProblem": "dolfinx_mortar.solver.elastic",
     "ContactDivergenceError": "dolfinx_mortar.solver.convergence",
     "RigidPlane": "dolfinx_mortar.contact.obstacles",

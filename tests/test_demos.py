@@ -71,3 +71,18 @@ def test_demo_command_lines_pass_petsc_options_to_the_database():
     options.delValue("cli_test_snes_rtol")
     with pytest.raises(SystemExit):
         parse_args_and_petsc_options(parser, ["--bogus"])
+
+
+def test_quickstart_runs_and_balances(tmp_path, monkeypatch):
+    """The README's example, as printed there: it converges, and the contact
+    force on the block is what the top face's support holds (equilibrium)."""
+    import runpy
+    from dolfinx_mortar import reaction_force
+    from mpi4py import MPI
+    workdir = MPI.COMM_WORLD.bcast(str(tmp_path), root=0)
+    monkeypatch.chdir(workdir)
+    scene = runpy.run_path(str(DEMOS / "quickstart.py"))
+    force = scene["contact"].contact_force()
+    assert force[1] > 0 and abs(force[0]) < 1e-8 * force[1]
+    reaction = reaction_force(scene["problem"], scene["facet_tags"], scene["TOP"])
+    assert reaction == pytest.approx(-force, rel=1e-8, abs=1e-10 * force[1])

@@ -23,6 +23,7 @@ from petsc4py import PETSc
 from dolfinx_mortar import (ContactDivergenceError, ContactProblem, ContactTerm, KIND_NAMES,
                             LoadPathSolver, NonlinearContactProblem, RigidPlane, RigidSphere,
                             reaction_force)
+from dolfinx_mortar.io.read_series import read_xdmf_series
 from dolfinx_mortar.solver.elastic import linear_elastic_residual
 
 BOTTOM, TOP, LEFT = 1, 2, 3
@@ -159,15 +160,21 @@ def test_load_path_moves_the_obstacle_and_takes_petsc_options(tmp_path):
     problem = NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact, bcs)
     solver = LoadPathSolver(problem, petsc_options={"snes_max_it": 7}, prefix="open_path_")
     seen = []
+    output = Path(domain.comm.bcast(str(tmp_path / "path.xdmf"), root=0))  # one file for all ranks
     result = solver.solve(lambda t: plane.move_to([0.0, 0.01 * t]), load_steps=3,
-                          output=tmp_path / "path.xdmf",
+                          output=output,
                           on_step=lambda step: seen.append(contact.contact_force()[1]))
     assert [s.load_factor for s in result.steps] == pytest.approx([1 / 3, 2 / 3, 1.0])
     p = [uniform_pressure(0.01 * t, 1e3) for t in (1 / 3, 2 / 3, 1.0)]
     assert seen == pytest.approx(p, rel=1e-8)
     assert not PETSc.Options().hasName("open_path_snes_max_it")
-    if domain.comm.rank == 0:
-        assert (tmp_path / "path.xdmf").exists() and (tmp_path / "path_slave.xdmf").exists()
+    domain.comm.barrier()
+    if domain.comm.rank == 0:   # read back what was written: every step, the right pressure
+        times, written = read_xdmf_series(output).field("contact_pressure")
+        assert times == pytest.approx([1 / 3, 2 / 3, 1.0])
+        assert written[:, :, 0].max(axis=1) == pytest.approx(p, rel=1e-8)
+        times, p_hat = read_xdmf_series(output.with_name("path_slave.xdmf")).field("p_hat")
+        assert p_hat[-1].max() == pytest.approx(p[-1], rel=1e-8)
     # an option no solver reads is named, not ignored
     misspelled = LoadPathSolver(problem, petsc_options={"snes_max_itt": 7}, prefix="open_bad_")
     with pytest.raises(ValueError, match="snes_max_itt"):
