@@ -98,7 +98,10 @@ class ContactResults:
         slave = self.slave
         n = slave.layout.num_owned
         length = self._node_lengths()
-        covered = self.model.covered & slave.layout.on_cells(slave.cells)
+        # nodes of this rank's cells (on_cells also counts other ranks' cells)
+        on_local_cell = np.zeros(slave.layout.size_local, dtype=bool)
+        on_local_cell[slave.cells] = True
+        covered = self.model.covered & on_local_cell
         depth = np.where(covered, gaps / np.where(covered, length, 1.0), -np.inf)[:n]
         worst = int(np.argmax(depth)) if n else -1
         local = ((float(depth[worst]), float(gaps[worst]), slave.x[worst].tolist())
