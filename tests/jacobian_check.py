@@ -51,12 +51,13 @@ def newton_history(start, problem, prefix: str) -> np.ndarray:
     start.u.vector.copy(problem.u.vector)
     problem.u.x.scatter_forward()
     problem.solver.prefix = prefix
-    snes = problem.solver.create_snes()
-    x = problem.u.vector.copy()
-    snes.setConvergenceHistory(reset=True)
-    snes.solve(None, x)
-    r = np.array(snes.getConvergenceHistory()[0])
-    snes.destroy()
+    with problem.solver.options():
+        snes = problem.solver.create_snes()
+        x = problem.u.vector.copy()
+        snes.setConvergenceHistory(reset=True)
+        snes.solve(None, x)
+        r = np.array(snes.getConvergenceHistory()[0])
+        snes.destroy()
     return r
 
 

@@ -81,17 +81,29 @@ class LoadPathSolver:
     def contacts(self):
         return self.problem.contacts
 
-    def create_snes(self) -> PETSc.SNES:
-        """A SNES with the problem's callbacks and the options of this solver."""
-        opts = PETSc.Options()
+    def default_options(self) -> dict:
+        """The solver's defaults (:data:`DEFAULT_OPTIONS`; ``bt`` line search when a
+        term uses the current configuration: there the first full Newton steps
+        of a slide diverged to NaN with ``basic``)."""
         defaults = dict(DEFAULT_OPTIONS)
         if any(term.basis_configuration == "current" for term in self.contacts):
-            # With the bases on the current surface the first full Newton steps
-            # of a slide diverged to NaN (basic); backtracking converged.
             defaults["snes_linesearch_type"] = "bt"
-        for key, value in defaults.items():
-            if not opts.hasName(self.prefix + key) and key not in self.petsc_options:
-                opts[self.prefix + key] = value
+        return defaults
+
+    def options(self) -> TemporaryOptions:
+        """This solver's options in the database for the duration of a ``with``
+        block: its defaults where the database does not set them, then
+        ``petsc_options``. Nothing stays behind, so that no later solver takes
+        these for options of its own."""
+        db = PETSc.Options()
+        merged = {key: value for key, value in self.default_options().items()
+                  if not db.hasName(self.prefix + key)}
+        merged.update(self.petsc_options)
+        return TemporaryOptions(self.prefix, merged)
+
+    def create_snes(self) -> PETSc.SNES:
+        """A SNES with the problem's callbacks, configured from the options
+        database (inside :meth:`options` for this solver's own)."""
         snes = PETSc.SNES().create(self.comm)
         snes.setOptionsPrefix(self.prefix)
         self.problem.configure_snes(snes)
@@ -134,7 +146,7 @@ class LoadPathSolver:
         if progress and self.comm.rank == 0:
             from tqdm import tqdm
             bar = tqdm(total=stepper.load_steps, desc="load steps", unit="step")
-        with TemporaryOptions(self.prefix, self.petsc_options):
+        with self.options():
             self._options_checked = False
             snes = self.create_snes()
             try:
