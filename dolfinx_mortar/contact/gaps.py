@@ -34,7 +34,7 @@ from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import (BasisKind, KindLike, is_global, is_partition_of_unity,
                                   parse_kind, unstarred_partner)
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
-from dolfinx_mortar.layout import MassMatrixSolver, NodeLayout, assemble_blocks
+from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.pointwise import MortarPointGaps, obstacle_positive_gaps

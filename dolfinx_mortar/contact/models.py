@@ -15,7 +15,7 @@ import numpy.typing as npt
 from mpi4py import MPI
 
 from dolfinx_mortar.contact.current_mortar import CurrentMortarGap
-from dolfinx_mortar.contact.finite_deformation import CurrentObstacleGap
+from dolfinx_mortar.contact.finite_deformation import DUAL_KINDS, CurrentObstacleGap
 from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap, gap_kind
 from dolfinx_mortar.contact.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle
@@ -28,7 +28,6 @@ FloatArray = npt.NDArray[np.float64]
 
 ACTIVE_SETS = ("nodal", "pointwise")
 CONFIGURATIONS = ("initial", "previous", "current")
-DUAL_KINDS = (BasisKind.LcLS_star, BasisKind.LcLS)
 
 
 @dataclass(frozen=True)

@@ -113,7 +113,7 @@ class ContactResults:
                           "obstacle's position and normal, or the tags of slave and master",
                           RuntimeWarning, stacklevel=3)
 
-    def slip(self) -> float:
+    def slip(self, state: Optional[ContactState] = None) -> float:
         """The largest tangential slip of an active slave node since the bases
         were built, in element lengths of that node (over all ranks).
 
@@ -121,7 +121,7 @@ class ContactResults:
         obstacle's motion, or the mean displacement of the master nodes of the
         master cells its cells were paired with), without the normal part.
         """
-        state = self.evaluate()
+        state = state or self.evaluate()
         slave = self.slave
         u_nodes = nodal_displacement(slave, self.u)
         other = self._partner_displacement(u_nodes)
@@ -138,7 +138,7 @@ class ContactResults:
                          / np.maximum(self._node_lengths(), np.finfo(float).tiny), 0.0)
         n = slave.layout.num_owned
         return float(self.mesh.comm.allreduce(float(np.max(ratio[:n], initial=0.0)),
-                                               op=_max_op()))
+                                               op=MPI.MAX))
 
     def _partner_displacement(self, u_nodes: FloatArray) -> FloatArray:
         """What each slave node touches moves by: the obstacle's displacement, or
@@ -161,7 +161,7 @@ class ContactResults:
             np.add.at(count, ends, 1.0)
         return total / np.maximum(count, 1.0)[:, None]
 
-    def warn_if_slipped_too_far(self) -> None:
+    def warn_if_slipped_too_far(self, state: Optional[ContactState] = None) -> None:
         """With ``basis_configuration="initial"``: warn (once) past SLIP_LIMIT
         element lengths of slip (:meth:`slip`). A press-then-slide run gave a
         normal force growing 3× and a frictionless tangential force of 33% of
@@ -170,7 +170,7 @@ class ContactResults:
         if (self.basis_configuration != "initial" or self.obstacle is not None
                 or getattr(self, "_slip_warned", False)):
             return
-        s = self.slip()
+        s = self.slip(state)
         if s > SLIP_LIMIT:
             self._slip_warned = True
             warnings.warn(f"contact surfaces slipped {s:.3g} element lengths past the "
@@ -178,10 +178,6 @@ class ContactResults:
                           "to about one element of slip): the forces are no longer reliable; "
                           "use basis_configuration='previous' or 'current'",
                           RuntimeWarning, stacklevel=3)
-
-
-def _max_op():
-    return MPI.MAX
 
 
 def _gather_entries(vec: PETSc.Vec, indices: npt.NDArray) -> FloatArray:

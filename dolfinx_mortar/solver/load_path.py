@@ -187,8 +187,8 @@ class LoadPathSolver:
                     stepper.succeeded()
                     if bar is not None:
                         bar.update(stepper.fraction_of_steps - before)
-                    for term in self.contacts:
-                        term.warn_if_slipped_too_far()
+                    for term, state in zip(self.contacts, states):
+                        term.warn_if_slipped_too_far(state)
                     if writer is not None:
                         writer.write(target, states)
                     if on_step is not None:
