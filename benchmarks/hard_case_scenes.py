@@ -2,7 +2,7 @@
 
 Every function here builds one hard scene, solves or assembles it and returns
 plain numbers; ``benchmarks/hard_cases.py`` prints them as a table and
-``tests/test_hard_cases.py`` holds them to pass criteria. Keeping the scenes in
+``tests/contact/test_hard_cases.py`` holds them to pass criteria. Keeping the scenes in
 one place means the table and the tests report the very same numbers.
 
 Operator-level cases (the sweep, the quadratic facets) run on ``COMM_SELF`` on

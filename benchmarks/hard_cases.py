@@ -1,7 +1,7 @@
 """Table of the hard cases (issue 5): one row per case, variant and kind.
 
 Runs the scenes of hard_case_scenes.py, checks each against its pass
-criterion (the same as tests/test_hard_cases.py), prints a table and writes
+criterion (the same as tests/contact/test_hard_cases.py), prints a table and writes
 results/hard_cases.csv (metric, value, criterion, verdict per row).
 
     /usr/bin/python3 benchmarks/hard_cases.py [--skip-slow] [--cases sweep penalty ...]

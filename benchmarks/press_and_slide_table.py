@@ -29,7 +29,6 @@ from mpi4py import MPI
 
 from dolfinx_mortar import ContactDivergenceError
 from dolfinx_mortar.io.output import write_atomically, write_csv
-from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS
 
 HERE = Path(__file__).resolve().parent
 DEMO = HERE.parent / "demos" / "press_and_slide.py"
@@ -37,7 +36,7 @@ KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 CONFIGURATIONS = ("initial", "previous", "current")
 COLUMNS = ("kind", "configuration", "status", "tangential_oscillation", "tangential_std",
            "tangential_mean", "normal_oscillation", "normal_mean", "newton_iterations",
-           "max_newton_per_step", "load_steps", "requested_steps", "wall_time", "dofs", "h",
+           "max_newton_per_step", "max_quadratic_constant", "load_steps", "requested_steps", "wall_time", "dofs", "h",
            "reason")
 
 
@@ -56,6 +55,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         help="the demo's --penalty, a multiple of E/h (1e2)")
     parser.add_argument("--slide-steps", type=int, default=None,
                         help="the demo's --slide-steps (default: its own, 4 per element)")
+    parser.add_argument("--predictor", default="linear", choices=("none", "linear"),
+                        help="the demo's --predictor (linear)")
     parser.add_argument("--kinds", nargs="+", default=list(KINDS))
     parser.add_argument("--configurations", nargs="+", default=list(CONFIGURATIONS),
                         choices=CONFIGURATIONS)
@@ -64,30 +65,14 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
-def forget_solver_defaults(prefix: str = "dolfinx_mortar_") -> None:
-    """Remove the solver defaults that an earlier run left in the options database.
-
-    LoadPathSolver writes its default options into PETSc's global database and
-    leaves them there; the next solver takes them for the user's (command line
-    wins) and skips its own defaults: every "current" run after an "initial"
-    one then used the basic line search instead of its default bt. Each row
-    should be what one run of the demo does.
-    """
-    from petsc4py import PETSc
-    options = PETSc.Options()
-    for key in DEFAULT_OPTIONS:
-        if options.hasName(prefix + key):
-            options.delValue(prefix + key)
-
-
 def run(demo, kind: str, configuration: str, args: argparse.Namespace) -> dict:
     """One demo run as a table row; refusals and divergence become the row's status."""
     argv = ["--kind", kind, "--configuration", configuration, "--refine", str(args.refine),
             "--penalty", str(args.penalty), "--quiet"]
     if args.slide_steps is not None:
         argv += ["--slide-steps", str(args.slide_steps)]
+    argv += ["--predictor", args.predictor]
     row = {"kind": kind, "configuration": configuration}
-    forget_solver_defaults()
     clock = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -117,14 +102,17 @@ def markdown_table(rows: list[dict], args: argparse.Namespace) -> str:
     lines = [
         f"Press and slide, refine {args.refine:g} (h = {h}), "
         f"ε = {args.penalty:g} E/h, {MPI.COMM_WORLD.size} rank(s), the library's default "
-        "line search (basic; bt for current). Steady sliding: past 2 element lengths of "
+        f"line search (basic; l2 for current), predictor {args.predictor}. Steady sliding: "
+        "past 2 element lengths of "
         "slide; F_t, N: tangential and normal force on the obstacle, relative to the mean "
         "normal force N over the slide distance. Steps: converged (requested); more "
-        "converged than requested means cut steps.",
+        "converged than requested means cut steps. C: the largest e_k+1 / e_k² at the last "
+        "Newton iterate of a step (e: residual / out-of-balance force of the step); "
+        "order one is quadratic convergence.",
         "",
         "| kind | configuration | status | F_t max−min / N | F_t std / N | F_t mean / N "
-        "| N max−min / N | N | Newton (max/step) | steps (requested) | wall s | note |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| N max−min / N | N | Newton (max/step) | C | steps (requested) | wall s | note |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         newton = (f"{r['newton_iterations']} ({r['max_newton_per_step']})"
@@ -136,7 +124,7 @@ def markdown_table(rows: list[dict], args: argparse.Namespace) -> str:
             f"| {fmt(r.get('tangential_oscillation'), '.2e')} "
             f"| {fmt(r.get('tangential_std'), '.2e')} | {fmt(r.get('tangential_mean'), '+.2e')} "
             f"| {fmt(r.get('normal_oscillation'), '.2e')} | {fmt(r.get('normal_mean'), '.5f')} "
-            f"| {newton} | {steps} | {r['wall_time']:.1f} | {r.get('reason') or ''} |")
+            f"| {newton} | {fmt(r.get('max_quadratic_constant'), '.2g')} | {steps} | {r['wall_time']:.1f} | {r.get('reason') or ''} |")
     return "\n".join(lines)
 
 

@@ -44,7 +44,8 @@ STEADY_AFTER = 2.0
 #: default slide steps per element length
 STEPS_PER_ELEMENT = 4
 COLUMNS = ("step", "t", "phase", "obstacle_x", "obstacle_y", "slide", "normal_force",
-           "tangential_force", "pressure_integral", "active_nodes", "newton_iterations")
+           "tangential_force", "pressure_integral", "active_nodes", "newton_iterations",
+           "quadratic_constant")
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
@@ -67,7 +68,12 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         help="load steps sliding (default: 4 per element length h, so "
                              "that the ripple of period h is resolved)")
     parser.add_argument("--linesearch", default=None, choices=("basic", "bt", "l2", "cp"),
-                        help="SNES line search (default: the library's, bt for 'current')")
+                        help="SNES line search (default: the library's, l2 for 'current')")
+    parser.add_argument("--predictor", default="linear", choices=("none", "linear"),
+                        help="Newton's start in each step: the last solution, or extrapolated "
+                             "linearly from the last two (linear)")
+    parser.add_argument("--histories", action="store_true",
+                        help="print every step's Newton residual history")
     parser.add_argument("--output", default=None, help="XDMF file of the steps")
     parser.add_argument("--csv", default=None, help="per-step forces as CSV")
     parser.add_argument("--png", default=None, help="force history figure")
@@ -267,14 +273,16 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
             "slide": float(cylinder.displacement[0]),
             "normal_force": float(force[1]), "tangential_force": float(force[0]),
             "pressure_integral": contact.normal_force(), "active_nodes": step.active_nodes,
-            "newton_iterations": step.newton_iterations})
+            "newton_iterations": step.newton_iterations,
+            "quadratic_constant": step.quadratic_constant(), "residuals": step.phases})
 
     options = {"snes_linesearch_type": args.linesearch} if args.linesearch else None
     solver = LoadPathSolver(problem, petsc_options=options)
     steps = args.press_steps + args.slide_steps
     try:
         result = solver.solve(update, load_steps=steps, output=args.output,
-                              progress=not args.quiet and comm.rank == 0, on_step=record)
+                              progress=not args.quiet and comm.rank == 0, on_step=record,
+                              predictor=args.predictor)
     except ContactDivergenceError as error:
         if comm.rank == 0 and not args.quiet:
             print(f"press and slide: Newton failed after {len(rows)} converged steps\n{error}")
@@ -289,12 +297,14 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
         "load_steps": len(result.steps), "requested_steps": steps,
         "newton_iterations": result.newton_iterations,
         "max_newton_per_step": max(r["newton_iterations"] for r in rows),
+        "predictor": args.predictor,
+        "max_quadratic_constant": max(r["quadratic_constant"] for r in rows),
         "wall_time": wall, "ranks": comm.size, "steps": rows})
     title = (f"{args.kind}, basis_configuration={args.configuration}, "
              f"ε = {args.penalty:g} E/h, h = {h:g}")
     if comm.rank == 0:
         if not args.quiet:
-            report(figures)
+            report(figures, args.histories)
         if args.csv:
             write_csv(args.csv, rows, COLUMNS)
         if args.json:
@@ -304,8 +314,15 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
     return figures
 
 
-def report(f: dict) -> None:
-    """Print the key figures of :func:`main`."""
+def report(f: dict, histories: bool = False) -> None:
+    """Print the key figures of :func:`main` (and every step's residual norms)."""
+    if histories:
+        print("Newton residual norms per step (| separates the solves on the frozen and "
+              "the current surface); C: e_k+1 = C e_k^2 at the last iterate")
+        for r in f["steps"]:
+            norms = " | ".join(" ".join(f"{x:.1e}" for x in phase) for phase in r["residuals"])
+            print(f"  {r['step']:4d} t = {r['t']:.4f} {r['phase']:5s} C = "
+                  f"{r['quadratic_constant']:8.2g}: {norms}")
     print(f"Press and slide ({f['kind']}, {f['configuration']}, {f['dofs']} dofs, "
           f"h = {f['h']:g}, slide {f['slide_in_elements']:.3g} h, {f['ranks']} rank(s))")
     if "normal_mean" in f:
@@ -315,7 +332,10 @@ def report(f: dict) -> None:
         print(f"  tangential / mean normal: mean {f['tangential_mean']:+.3e}, max-min "
               f"{f['tangential_oscillation']:.3e}, std {f['tangential_std']:.3e}")
     print(f"  Newton iterations {f['newton_iterations']} in {f['load_steps']} steps "
-          f"(at most {f['max_newton_per_step']} per step), wall time {f['wall_time']:.2f} s")
+          f"(at most {f['max_newton_per_step']} per step, predictor {f['predictor']}), "
+          f"wall time {f['wall_time']:.2f} s")
+    print(f"  quadratic convergence: e_k+1 <= {f['max_quadratic_constant']:.2g} e_k^2 at the "
+          f"last iterate of every step (e: residual / first residual of the step)")
 
 
 if __name__ == "__main__":

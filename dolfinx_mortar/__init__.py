@@ -13,7 +13,9 @@ Subpackages, one per layer of the Python library:
 - :mod:`~dolfinx_mortar.contact`: gap models, rigid obstacles and the contact
   term that adds penalty contact to a DOLFINx model;
 - :mod:`~dolfinx_mortar.solver`: the nonlinear problem, Newton and the load path;
-- :mod:`~dolfinx_mortar.io`: XDMF series, gmsh, merged meshes, result files.
+- :mod:`~dolfinx_mortar.io`: XDMF series, gmsh, merged meshes, result files;
+- :mod:`~dolfinx_mortar.kernels`: the C++ kernels (facet geometry,
+  segmentation, mortar integrals, basis coefficients).
 
 The names that need DOLFINx (``ContactTerm``, ``NonlinearContactProblem``,
 ``LoadPathSolver``, ``ContactProblem``, the obstacles) are imported on first

@@ -1,12 +1,18 @@
-"""Each MPI rank runs its own pytest session: give each its own temporary root.
+"""Shared pytest set-up.
 
-pytest prunes old numbered folders under /tmp/pytest-of-<user>; two ranks
-sharing that root can delete each other's files mid-test.
+- The test helpers live in ``tests/support``; the test folders mirror the
+  package's subpackages, so put ``tests/`` on the path once, here.
+- Each MPI rank runs its own pytest session: give each its own temporary root.
+  pytest prunes old numbered folders under /tmp/pytest-of-<user>; two ranks
+  sharing that root can delete each other's files mid-test.
 """
 from __future__ import annotations
 
+import sys
 import tempfile
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 def pytest_configure(config):

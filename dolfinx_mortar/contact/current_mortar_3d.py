@@ -46,7 +46,8 @@ def _value(x) -> float:
     return float(x.value[0]) if isinstance(x, Jet) else float(x)
 
 
-def _signed_area(polygon: list) -> Jet:
+def signed_area(polygon: list) -> Jet:
+    """Signed area of a planar polygon (shoelace formula), positive counter-clockwise."""
     total = 0.0
     for i, p in enumerate(polygon):
         q = polygon[(i + 1) % len(polygon)]
@@ -170,11 +171,11 @@ def pair_gap_3d(values: FloatArray, normal_cells: list, num_slave_nodes: int,
             return None
     slave_polygon = [plane(p) for p in own]
     master_polygon = [plane(p) for p in master]
-    if _value(_signed_area(master_polygon)) < 0:
+    if _value(signed_area(master_polygon)) < 0:
         master_polygon.reverse()
     clipped = clip_polygon(slave_polygon, master_polygon, zero)
     # no wider than the zero length: a segment or a point (the kernel's test)
-    if len(clipped) < 3 or not 2 * _value(_signed_area(clipped)) > zero * _longest_edge(clipped):
+    if len(clipped) < 3 or not 2 * _value(signed_area(clipped)) > zero * _longest_edge(clipped):
         return None
     m = len(clipped)
     g = [sum((q[k] for q in clipped[1:]), clipped[0][k]) * (1.0 / m) for k in range(2)]

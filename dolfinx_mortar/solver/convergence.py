@@ -3,7 +3,7 @@
 PETSc's default test accepts a step when ``‖R‖ ≤ rtol ‖R₀‖`` with ``R₀`` the
 residual where Newton starts, or when the Newton step is small
 (``CONVERGED_SNORM_RELATIVE``). Neither means equilibrium here: the
-gap-closing start (:meth:`ContactProblem._close_gaps`) can raise ``‖R₀‖`` to
+gap-closing start (:func:`~dolfinx_mortar.solver.newton_start.close_gaps`) can raise ``‖R₀‖`` to
 1e8 times the load, and with a huge penalty the Newton step reaches round-off
 while ``‖R‖`` is still a percent of the load (the force balance was then off
 by 0.4 … 1.8%, silently). :class:`EquilibriumTest` accepts a step only when

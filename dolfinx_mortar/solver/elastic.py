@@ -152,16 +152,17 @@ class ContactProblem:
 
     def solve(self, load_steps: int = 1, output: Optional[Union[str, Path]] = None,
               max_cuts: int = 5, progress: bool = False, prefix: Optional[str] = None,
-              on_step: Optional[Callable[["ContactProblem", StepResult], None]] = None
-              ) -> SolveResult:
+              on_step: Optional[Callable[["ContactProblem", StepResult], None]] = None,
+              predictor: str = "none") -> SolveResult:
         """Apply the load in ``load_steps`` equal steps
-        (:meth:`~dolfinx_mortar.solver.load_path.LoadPathSolver.solve`);
-        ``on_step(problem, step)`` after each converged step."""
+        (:meth:`~dolfinx_mortar.solver.load_path.LoadPathSolver.solve`, where
+        ``predictor`` is described); ``on_step(problem, step)`` after each
+        converged step."""
         if prefix is not None:
             self.solver.prefix = prefix
         callback = None if on_step is None else (lambda step: on_step(self, step))
         return self.solver.solve(self.set_load, load_steps, output, max_cuts, progress,
-                                 callback)
+                                 callback, predictor)
 
     # -- results ---------------------------------------------------------------------
     def nodal_gaps(self):

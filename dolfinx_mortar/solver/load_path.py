@@ -12,7 +12,6 @@ attempt's cause with its residual history. Converged steps go to XDMF.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional, Union
 
@@ -24,30 +23,10 @@ from dolfinx_mortar.io.contact_output import ContactOutput
 from dolfinx_mortar.solver.convergence import (ContactDivergenceError, EquilibriumTest,
                                                FailedAttempt, describe_failure)
 from dolfinx_mortar.solver.load_stepping import LoadStepper
+from dolfinx_mortar.solver.newton_start import PathExtrapolation, close_gaps
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
-
-
-@dataclass
-class StepResult:
-    """One converged load step."""
-
-    load_factor: float
-    newton_iterations: int
-    residuals: list
-    wall_time: float
-    active_nodes: int
-
-
-@dataclass
-class SolveResult:
-    """All converged steps."""
-
-    steps: list = field(default_factory=list)
-
-    @property
-    def newton_iterations(self) -> int:
-        return sum(s.newton_iterations for s in self.steps)
+from dolfinx_mortar.solver.step_results import SolveResult, StepResult
 
 
 class LoadPathSolver:
@@ -123,7 +102,8 @@ class LoadPathSolver:
     def solve(self, update: Callable[[float], None], load_steps: int = 1,
               output: Optional[Union[str, Path]] = None, max_cuts: int = 5,
               progress: bool = False,
-              on_step: Optional[Callable[[StepResult], None]] = None) -> SolveResult:
+              on_step: Optional[Callable[[StepResult], None]] = None,
+              predictor: str = "none") -> SolveResult:
         """Follow the load path from t = 0 to 1 in ``load_steps`` steps.
 
         Parameters
@@ -141,7 +121,14 @@ class LoadPathSolver:
             A tqdm progress bar on rank 0.
         on_step
             Called with each converged step's :class:`StepResult`.
+        predictor
+            Where Newton starts a step: ``"none"`` from the last converged u,
+            ``"linear"`` from u extrapolated linearly in t through the last
+            two converged steps (fewer iterations on a smooth path such as a
+            sliding obstacle; a kink of the path costs one poor start).
         """
+        if predictor not in ("none", "linear"):
+            raise ValueError(f"predictor must be 'none' or 'linear', not {predictor!r}")
         stepper = LoadStepper(load_steps, max_cuts)
         u = self.problem.u
         if not np.all(np.isfinite(u.x.array)):
@@ -149,6 +136,7 @@ class LoadPathSolver:
         writer = ContactOutput(Path(output), u, self.contacts) if output is not None else None
         result = SolveResult()
         failures: list[FailedAttempt] = []
+        path = PathExtrapolation() if predictor == "linear" else None
         bar = None
         if progress and self.comm.rank == 0:
             from tqdm import tqdm
@@ -166,7 +154,10 @@ class LoadPathSolver:
                     saved = u.vector.copy()
                     clock = time.perf_counter()
                     x = u.vector.copy()
-                    reason, history, iterations, cause = self.newton_step(snes, x)
+                    increment = path.increment(target) if path is not None else None
+                    reason, phases, iterations, cause, reference = self.newton_step(
+                        snes, x, increment)
+                    history = [r for phase in phases for r in phase]
                     if reason <= 0:
                         failures.append(FailedAttempt(target, reason, history, cause))
                         stepper.failed()
@@ -178,10 +169,13 @@ class LoadPathSolver:
                     failures = []
                     x.copy(u.vector)
                     u.x.scatter_forward()
+                    if path is not None:
+                        path.converged(target, u.vector)
                     states = [term.evaluate() for term in self.contacts]
                     active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
                     step = StepResult(target, iterations, history,
-                                      time.perf_counter() - clock, active)
+                                      time.perf_counter() - clock, active, phases, reference,
+                                      self.equilibrium.floor_rtol * reference)
                     result.steps.append(step)
                     before = stepper.fraction_of_steps
                     stepper.succeeded()
@@ -199,9 +193,12 @@ class LoadPathSolver:
                 snes.destroy()
         return result
 
-    def newton_step(self, snes: PETSc.SNES, x: PETSc.Vec) -> tuple[int, list, int, str]:
-        """One load step's Newton solve from x: SNES reason, residuals, iterations
-        and, if it failed, what stopped it (in words).
+    def newton_step(self, snes: PETSc.SNES, x: PETSc.Vec,
+                    increment: Optional[PETSc.Vec] = None
+                    ) -> tuple[int, list, int, str, float]:
+        """One load step's Newton solve from x (plus a predictor's ``increment``):
+        SNES reason, the residual norms of each SNES solve, iterations, what
+        stopped it if it failed (in words), and the force scale F.
 
         The step is accepted when ``‖R‖ ≤ rtol·F``
         (:class:`~dolfinx_mortar.solver.convergence.EquilibriumTest`) with F the
@@ -215,19 +212,23 @@ class LoadPathSolver:
         iterations overshoot to pressures whose geometric stiffness is larger
         than the bulk's, and Newton cycled or diverged (Hertz 2D).
         """
-        history: list = []
+        phases: list = []
         iterations = 0
         b = self.problem.vector()
         self.problem.F(x, b)
-        self.equilibrium.start(b.norm())
+        reference = b.norm()
+        self.equilibrium.start(reference)
+        if increment is not None:
+            x.axpy(1.0, increment)
         two_phase = any(term.basis_configuration == "current" for term in self.contacts)
         for frozen in ([True, False] if two_phase else [False]):
             reason = self._solve_phase(snes, x, frozen)
-            history += list(snes.getConvergenceHistory()[0])
+            phases.append([float(r) for r in snes.getConvergenceHistory()[0]])
             iterations += snes.getIterationNumber()
             if reason <= 0:
-                return reason, history, iterations, describe_failure(snes, self.equilibrium)
-        return reason, history, iterations, ""
+                return (reason, phases, iterations,
+                        describe_failure(snes, self.equilibrium), reference)
+        return reason, phases, iterations, "", reference
 
     def _solve_phase(self, snes: PETSc.SNES, x: PETSc.Vec, frozen: bool) -> int:
         from contextlib import ExitStack
@@ -235,7 +236,7 @@ class LoadPathSolver:
             if frozen:
                 for term in self.contacts:
                     stack.enter_context(term.frozen())
-            self.close_gaps(snes, x)
+            close_gaps(self.problem, snes.getKSP(), x)
             snes.setConvergenceHistory(reset=True)
             clock = time.perf_counter()
             snes.solve(None, x)
@@ -246,36 +247,6 @@ class LoadPathSolver:
             self._check_petsc_options()
             self._options_checked = True
         return snes.getConvergedReason()
-
-    def close_gaps(self, snes: PETSc.SNES, x: PETSc.Vec) -> None:
-        """Move x into contact when nothing touches yet (a better Newton start).
-
-        With positive mortar functions a body that touches at a point has
-        d̄ < 0 at every node, no contact force, and Newton's linear model —
-        stiff only from the current gap on — creeps towards the obstacle by
-        F/(εA) per iteration. This step solves the linear model in which the
-        nodes near contact carry the force ``ω(d̄ + GΔu)``, which closes their
-        gaps: it overshoots by about the largest of those gaps (a tenth of an
-        element), which Newton then takes back. It changes only where Newton
-        starts, not the solution.
-        """
-        b = self.problem.vector()
-        self.problem.F(x, b)
-        pulls = [term.gap_closing_force() for term in self.contacts]
-        if all(p is None for p in pulls):
-            return
-        A = self.problem.matrix()
-        self.problem.J(x, A)
-        rhs = b.copy()
-        for pull in pulls:
-            if pull is not None:
-                rhs.axpy(1.0, pull)
-        ksp = snes.getKSP()
-        ksp.setOperators(A)
-        dx = rhs.duplicate()
-        ksp.solve(rhs, dx)
-        if ksp.getConvergedReason() > 0:
-            x.axpy(-1.0, dx)
 
     def _check_petsc_options(self) -> None:
         """Refuse options under the prefix that no PETSc object read (misspelled)."""

@@ -6,12 +6,13 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.contact.finite_deformation import area_element_derivatives
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactProblem
-from jacobian_check import convergence_order, jacobian_error, newton_history
-from test_problem import LOCAL_KINDS, block_on_plane, load, pressed_block
+from support.jacobian_check import (convergence_order, energy_gradient_error, jacobian_error,
+                                    newton_history)
+from support import load_demo
+from support.scenes import LOCAL_KINDS, block_on_plane, pressed_block
 
 
 @pytest.mark.parametrize("shape", [(2, 1), (3, 1), (3, 2)])
@@ -39,27 +40,6 @@ def _deformed_block(kind, scaling, n=(8, 3)):
     return problem
 
 
-def _energy_gradient_error(problem) -> float:
-    """|Π(u + h v) − Π(u − h v)|/2h against R_c·v: the residual is ∂Π/∂u."""
-    model = problem.gap_model
-    x0 = problem.u.vector.copy()
-    Rc = problem.contact.update(problem.bcs).residual
-    v = x0.duplicate()
-    v.array[:] = np.random.default_rng(5 + MPI.COMM_WORLD.rank).normal(size=v.array.shape)
-    fem.petsc.set_bc(v, problem.bcs, scale=0.0)
-    h = 1e-6 / v.norm()
-    energies = []
-    for sign in (1, -1):
-        x0.copy(problem.u.vector)
-        problem.u.vector.axpy(sign * h, v)
-        problem.u.x.scatter_forward()
-        energies.append(model.energy(nodal_displacement(problem.slave, problem.u)))
-    x0.copy(problem.u.vector)
-    problem.u.x.scatter_forward()
-    exact = Rc.dot(v)
-    return abs((energies[0] - energies[1]) / (2 * h) - exact) / abs(exact)
-
-
 @pytest.mark.parametrize("scaling", ["consistent", "seed"])
 @pytest.mark.parametrize("kind", LOCAL_KINDS)
 def test_current_residual_is_the_gradient_and_the_jacobian_is_exact(kind, scaling):
@@ -67,7 +47,7 @@ def test_current_residual_is_the_gradient_and_the_jacobian_is_exact(kind, scalin
     gaps = problem.nodal_gaps()
     n = problem.slave.layout.num_owned
     assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) >= 3
-    assert _energy_gradient_error(problem) < 1e-6
+    assert energy_gradient_error(problem) < 1e-6
     assert jacobian_error(problem) < 1e-7
 
 
@@ -83,7 +63,7 @@ def test_current_jacobian_is_exact_on_curved_p2_facets():
     # a curved slave surface: its area element varies along every facet
     problem.u.interpolate(lambda x: np.vstack([0.05 * x[0] ** 2,
                                                -0.02 + 0.03 * x[0] ** 2 - 0.02 * x[0] ** 3]))
-    assert _energy_gradient_error(problem) < 1e-6
+    assert energy_gradient_error(problem) < 1e-6
     assert jacobian_error(problem) < 1e-7
 
 
@@ -108,12 +88,12 @@ def test_current_jacobian_is_exact_in_3d():
         problem.set_load(1.0)
         problem.u.interpolate(lambda x: np.vstack([0.05 * x[2] + 0.05 * x[0] * x[1],
                                                    0.03 * x[0], -0.02 + 0.004 * x[1]]))
-        assert _energy_gradient_error(problem) < 1e-6
+        assert energy_gradient_error(problem) < 1e-6
         assert jacobian_error(problem) < 1e-7
 
 
 def _hertz2d_mesh(refine: str = "0.4"):
-    demo = load("hertz2d")
+    demo = load_demo("hertz2d")
     args = demo.parse_args(["--refine", refine])
     domain, tags, h = demo.build_mesh(args, demo.hertz(args)["a"], MPI.COMM_WORLD)
     return demo, fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags, h

@@ -1,6 +1,6 @@
 """A small contact run with many load steps and XDMF output, to be killed.
 
-Run by tests/test_output_crash.py (``python output_child.py <output.xdmf> <steps>``,
+Run by tests/io/test_output_crash.py (``python output_child.py <output.xdmf> <steps>``,
 on one rank or under mpirun). Prints ``ready <pid of every rank>`` once the
 problem is built, so that the killer knows the output is about to start.
 """
@@ -13,8 +13,8 @@ from pathlib import Path
 from dolfinx import fem
 from mpi4py import MPI
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from meshes import rectangle  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/, for support
+from support.meshes import rectangle  # noqa: E402
 from dolfinx_mortar.contact.obstacles import RigidPlane  # noqa: E402
 from dolfinx_mortar import ContactProblem  # noqa: E402
 

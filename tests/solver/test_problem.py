@@ -1,7 +1,6 @@
 """The contact solver: patch tests, Hertz 2D, the Jacobian, bad input, output, MPI."""
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -12,26 +11,10 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactDivergenceError, ContactProblem
-from jacobian_check import residual_difference
-from meshes import rectangle
-
-DEMOS = Path(__file__).resolve().parent.parent / "demos"
-LOCAL_KINDS = ["LmLS", "LmLS*", "LcLS*", "LcLS"]
-ALL_KINDS = ["GLS", "GLS*"] + LOCAL_KINDS
-
-
-def load(name):
-    spec = importlib.util.spec_from_file_location(name, DEMOS / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def block_on_plane(comm=MPI.COMM_WORLD, n=(8, 4)):
-    """[0,1]x[0,0.5]; tags: 1 bottom (slave), 2 top (load), 3 left (u_x = 0)."""
-    domain, tags = rectangle(comm, 0.0, 0.5, n, bottom=1, top=2, left=3)
-    return fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags
-
+from support.jacobian_check import residual_difference
+from support import load_demo
+from support.scenes import (ALL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks,
+                            block_on_plane, pressed_block)
 
 @pytest.mark.parametrize("kind", ALL_KINDS)
 def test_block_on_rigid_plane_carries_the_applied_pressure(kind):
@@ -48,7 +31,7 @@ def test_block_on_rigid_plane_carries_the_applied_pressure(kind):
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_patch_test_passes_with_the_consistent_scaling(dim):
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     args = demo.parse_args(["--dim", str(dim)] + (["--fine", "0.25", "--coarse", "0.35"]
                                                    if dim == 3 else []))
     for orientation in ("finer-slave", "finer-master"):
@@ -58,7 +41,7 @@ def test_patch_test_passes_with_the_consistent_scaling(dim):
 
 
 def test_seed_scaling_fails_the_patch_test():
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     args = demo.parse_args(["--dim", "2"])
     seed = demo.run(args, "finer-slave", "LmLS*", "seed")["max_relative_deviation"]
     assert seed > 1e-3  # node-wise penalty ε W_A on a non-uniform mesh
@@ -79,7 +62,7 @@ def test_starred_and_unstarred_kinds_give_the_same_problem_when_consistent(starr
 
 
 def test_hertz2d_coarse_is_within_one_percent():
-    figures = load("hertz2d").main(["--refine", "0.6"])
+    figures = load_demo("hertz2d").main(["--refine", "0.6"])
     assert abs(figures["p0_error"]) < 0.01
     assert abs(figures["a_error"]) < 0.01
     assert abs(figures["force_error"]) < 1e-8
@@ -88,25 +71,9 @@ def test_hertz2d_coarse_is_within_one_percent():
 
 @pytest.mark.slow
 def test_hertz2d_pressure_error_falls_with_refinement():
-    demo = load("hertz2d")
+    demo = load_demo("hertz2d")
     errors = [demo.main(["--refine", str(r)])["l2_error"] for r in (0.5, 1.0)]
     assert errors[1] < 0.7 * errors[0], errors
-
-
-def assert_same_hertz2d_figures_on_one_and_all_ranks(argv: list, make_problem) -> None:
-    """Solve the Hertz 2D scene of ``argv`` on all ranks and on this rank alone
-    (``make_problem(demo, V, tags, h)`` builds the problem, two load steps)."""
-    demo = load("hertz2d")
-    args = demo.parse_args(argv)
-    results = []
-    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
-        ref = demo.hertz(args)
-        domain, tags, h = demo.build_mesh(args, ref["a"], comm)
-        problem = make_problem(demo, fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags, h)
-        problem.solve(load_steps=2)
-        results.append(demo.contact_results(problem, ref))
-    for key in ("p0", "a", "l2_error", "contact_force"):
-        assert results[0][key] == pytest.approx(results[1][key], rel=1e-8), key
 
 
 @pytest.mark.parametrize("kind, active_set", [("LcLS*", "nodal"), ("LmLS*", "pointwise")])
@@ -117,17 +84,6 @@ def test_hertz2d_same_figures_on_one_and_all_ranks(kind, active_set):
                               active_set=active_set, fixed={demo.SYMMETRY: {0: 0.0}},
                               tractions={demo.LOAD: [0.0, -0.005]})
     assert_same_hertz2d_figures_on_one_and_all_ranks(["--refine", "0.4"], make_problem)
-
-
-def pressed_block(obstacle, kind: str, n=(6, 3), **options) -> ContactProblem:
-    """The block of :func:`block_on_plane` against ``obstacle``, fixed sideways on
-    its left, pushed down on its top (penalty 50), at full load."""
-    V, tags = block_on_plane(n=n)
-    problem = ContactProblem(V, tags, 1, obstacle=obstacle, E=1.0, nu=0.3, kind=kind,
-                             penalty=50.0, fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]},
-                             **options)
-    problem.set_load(1.0)
-    return problem
 
 
 @pytest.mark.parametrize("kind", ["LmLS", "LcLS*"])
@@ -354,14 +310,14 @@ def test_bad_input_is_reported():
 
 
 def test_hertz3d_coarse_sphere_on_rigid_plane():
-    demo = load("hertz3d")
+    demo = load_demo("hertz3d")
     figures = demo.run(demo.parse_args(["--refine", "0.5", "--load-steps", "2"]), MPI.COMM_WORLD)
     assert abs(figures["p0_error"]) < 0.10 and abs(figures["a_error"]) < 0.06, figures
     assert figures["contact_force"] == pytest.approx(figures["force"], rel=1e-8)
 
 
 def test_hertz3d_mesh_file_and_ranks_reproduce_the_builtin_scene(tmp_path_factory):
-    demo = load("hertz3d")
+    demo = load_demo("hertz3d")
     comm = MPI.COMM_WORLD
     path = comm.bcast(str(tmp_path_factory.mktemp("msh") / "octant.msh")
                       if comm.rank == 0 else None)
@@ -435,7 +391,7 @@ def test_gls_newton_step_inverts_the_residual_derivative(kind, active_set):
 
 
 def test_previous_configuration_resegments_and_still_passes_the_patch_test():
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     args = demo.parse_args(["--dim", "2"])
     from dolfinx import fem as _fem
     domain, tags = demo.build_mesh(2, args.fine, args.coarse, 1, MPI.COMM_WORLD)
@@ -461,7 +417,7 @@ def test_previous_configuration_resegments_and_still_passes_the_patch_test():
 
 
 def test_hertz2d_on_an_elastic_block():
-    figures = load("hertz2d").main(["--obstacle", "elastic", "--refine", "0.5"])
+    figures = load_demo("hertz2d").main(["--obstacle", "elastic", "--refine", "0.5"])
     assert abs(figures["p0_error"]) < 0.03 and abs(figures["a_error"]) < 0.03, figures
 
 
@@ -484,7 +440,7 @@ def test_previous_configuration_with_a_rigid_obstacle():
 
 
 def test_hertz3d_two_elastic_bodies_from_a_mesh_file(tmp_path_factory):
-    demo = load("hertz3d")
+    demo = load_demo("hertz3d")
     comm = MPI.COMM_WORLD
     path = comm.bcast(str(tmp_path_factory.mktemp("msh2") / "two_bodies.msh")
                       if comm.rank == 0 else None)
@@ -503,10 +459,10 @@ def test_hertz3d_two_elastic_bodies_from_a_mesh_file(tmp_path_factory):
 def test_first_touch_with_positive_mortar_functions_converges():
     """A sphere touching a plane at one point with LmLS*: every d̄_A < 0 at the start.
 
-    Without the gap-closing start (LoadPathSolver.close_gaps) Newton crept
+    Without the gap-closing start (dolfinx_mortar.solver.newton_start.close_gaps) Newton crept
     towards the plane by F/(εA) per iteration and failed after every cut-back.
     """
-    figures = load("hertz3d").main(["--kind", "LmLS*", "--refine", "0.7"])
+    figures = load_demo("hertz3d").main(["--kind", "LmLS*", "--refine", "0.7"])
     assert figures["contact_force"] == pytest.approx(figures["force"], rel=1e-8)
     assert figures["load_steps"] == 3   # no cut-back
     assert figures["newton_iterations"] <= 20

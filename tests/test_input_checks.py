@@ -6,12 +6,12 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar import MortarBasis, _kernels, basis, nurbs
+from dolfinx_mortar import MortarBasis, basis, kernels, nurbs
 from dolfinx_mortar.surfaces.facet_surface import facet_surface
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 
-from surfaces import curved_patch
+from support.surfaces import curved_patch
 
 W_KINDS = ["GLS*", "LmLS", "LcLS*", "LcLS"]
 
@@ -112,16 +112,16 @@ def test_nan_coordinates_are_rejected_by_the_kernels():
     x = np.array([[0.0, 0.0], [1.0, 0.0], [np.nan, 0.0]])
     cells = np.array([[0, 1], [1, 2]], dtype=np.int32)
     with pytest.raises(ValueError, match=r"node 2 has a non-finite coordinate \(nan, 0"):
-        _kernels.element_node_normals(_kernels.FacetType.P1_line, x, cells)
+        kernels.element_node_normals(kernels.FacetType.P1_line, x, cells)
     good = np.array([[0.0, 0.1], [1.0, 0.1], [2.0, 0.1]])
     with pytest.raises(ValueError, match="node 2 has a non-finite coordinate"):
-        _kernels.mortar_integrals(_kernels.FacetType.P1_line, good, cells, np.zeros((3, 2)),
-                                  _kernels.FacetType.P1_line, x, cells,
+        kernels.mortar_integrals(kernels.FacetType.P1_line, good, cells, np.zeros((3, 2)),
+                                  kernels.FacetType.P1_line, x, cells,
                                   np.zeros((0, 2), dtype=np.int32),
                                   np.array([[0.5]]), np.array([1.0]))
     x[2] = [np.inf, 0.0]
     with pytest.raises(ValueError, match="node 2 has a non-finite coordinate"):
-        _kernels.facet_bounding_boxes(_kernels.FacetType.P1_line, x, cells, 0.0)
+        kernels.facet_bounding_boxes(kernels.FacetType.P1_line, x, cells, 0.0)
 
 
 def test_nan_field_is_reported():

@@ -15,7 +15,7 @@ import pytest
 from dolfinx_mortar import KIND_NAMES, MortarBasis, basis, nurbs
 from dolfinx_mortar.kinds import is_partition_of_unity, unstarred_partner, kind_name
 
-from surfaces import curved_line, curved_patch
+from support.surfaces import curved_line, curved_patch
 
 TOL = 1e-11
 

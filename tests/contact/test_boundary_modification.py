@@ -7,7 +7,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactProblem
-from jacobian_check import jacobian_error
+from support.jacobian_check import jacobian_error
 
 GAP = 0.05
 

@@ -9,8 +9,9 @@ from mpi4py import MPI
 from dolfinx_mortar.contact.cut_quadrature import positive_part_rule
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactDivergenceError, ContactProblem
-from jacobian_check import jacobian_error
-from test_problem import ALL_KINDS, block_on_plane, load, pressed_block
+from support.jacobian_check import jacobian_error
+from support import load_demo
+from support.scenes import ALL_KINDS, block_on_plane, pressed_block
 
 # dual kinds appear here on purpose; the warning itself is tested at the end
 pytestmark = pytest.mark.filterwarnings("ignore:the pointwise active set with a dual kind")
@@ -59,7 +60,7 @@ def test_pointwise_jacobian_matches_finite_differences_on_cut_cells(kind, obstac
 
 
 def test_pointwise_jacobian_matches_finite_differences_elastic_master():
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     domain, tags = demo.build_mesh(2, 0.09, 0.14, 1, MPI.COMM_WORLD)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
@@ -83,7 +84,7 @@ def test_pointwise_jacobian_matches_finite_differences_elastic_master():
 @pytest.mark.parametrize("dim", [2, 3])
 def test_pointwise_equals_nodal_when_everything_penetrates(dim):
     """The patch test: every point penetrates, so ⟨d⟩ = d and both active sets agree."""
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     extra = ["--fine", "0.25", "--coarse", "0.35"] if dim == 3 else []
     kinds = ALL_KINDS if dim == 2 else ["GLS", "LmLS*", "LcLS*"]
     for kind in kinds:
@@ -93,7 +94,7 @@ def test_pointwise_equals_nodal_when_everything_penetrates(dim):
 
 
 def test_hertz2d_pointwise_is_within_one_percent():
-    figures = load("hertz2d").main(["--refine", "0.5", "--kind", "LmLS*",
+    figures = load_demo("hertz2d").main(["--refine", "0.5", "--kind", "LmLS*",
                                     "--active-set", "pointwise"])
     assert abs(figures["p0_error"]) < 0.01
     assert abs(figures["a_error"]) < 0.01
@@ -109,7 +110,7 @@ def test_hertz2d_pointwise_is_within_one_percent():
                "indefinite Jacobian: Newton cycles (residual histories in the issue note)")),
 ])
 def test_pointwise_newton_converges_on_hertz2d(kind):
-    figures = load("hertz2d").main(["--refine", "0.4", "--kind", kind, "--active-set",
+    figures = load_demo("hertz2d").main(["--refine", "0.4", "--kind", kind, "--active-set",
                                     "pointwise", "--load-steps", "4"])
     assert abs(figures["force_error"]) < 1e-8
     assert abs(figures["p0_error"]) < 0.02

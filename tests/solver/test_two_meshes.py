@@ -14,7 +14,7 @@ from mpi4py import MPI
 
 from dolfinx_mortar.io.merge_meshes import BODY_A, BODY_B, merge_meshes
 from dolfinx_mortar import ContactProblem
-from meshes import rectangle
+from support.meshes import rectangle
 
 ALL_KINDS = ["GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS"]
 # patch test tags (as in demos/patch_test.py); LEFT is one symmetry plane through both

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 from petsc4py import PETSc
 
-from dolfinx_mortar import KIND_NAMES, _kernels
+from dolfinx_mortar import KIND_NAMES, kernels
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface, ReferenceLagrange
 from dolfinx_mortar.mortar.coupling import MortarCoupling, to_scipy
 
-from surfaces import flat_line, flat_patch
+from dolfinx_mortar.surfaces.structured import flat_line, flat_patch
 
 ELEMENTS = {  # name: (cell, degree, serendipity, transform)
     "P1-line": ("interval", 1, False, False),
@@ -236,7 +236,7 @@ def test_kernel_shape_functions_match_basix(name):
     X = (basix.create_lattice(ref.cell_type, 5, basix.LatticeType.equispaced, True)
          if cell != "interval" else np.linspace(0, 1, 6)[:, None])
     N, dN = ref.tabulate(X)
-    Nk, dNk = _kernels.facet_shape_functions(ref.facet_type, X)
+    Nk, dNk = kernels.facet_shape_functions(ref.facet_type, X)
     assert np.allclose(N, Nk, atol=1e-14) and np.allclose(dN, dNk, atol=1e-13)
     mirrored = ref.nodes[:, ::-1] if cell != "interval" else 1 - ref.nodes
     assert np.allclose(ref.nodes[ref.reflection], mirrored)
@@ -248,7 +248,7 @@ def test_candidate_search_matches_brute_force():
     a = np.hstack([lo, lo + rng.uniform(0, 1, (300, 3))])
     lo = rng.uniform(0, 10, (200, 3))
     b = np.hstack([lo, lo + rng.uniform(0, 1, (200, 3))])
-    pairs = {tuple(p) for p in _kernels.overlapping_box_pairs(a, b)}
+    pairs = {tuple(p) for p in kernels.overlapping_box_pairs(a, b)}
     brute = {(i, j) for i in range(300) for j in range(200)
              if np.all(a[i, :3] <= b[j, 3:]) and np.all(b[j, :3] <= a[i, 3:])}
     assert pairs == brute and len(brute) > 0

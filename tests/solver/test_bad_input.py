@@ -10,7 +10,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.kinds import parse_kind
 from dolfinx_mortar.contact.obstacles import RigidPlane
 from dolfinx_mortar import ContactProblem
-from meshes import rectangle
+from support.meshes import rectangle
 
 PLANE = RigidPlane([0, 0], [0, 1])
 

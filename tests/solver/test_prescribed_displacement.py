@@ -13,13 +13,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from dolfinx import fem
-from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactProblem
-from meshes import rectangle
+from support.meshes import rectangle
 
 ALL_KINDS = ["GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS"]
 BOTTOM, TOP, LEFT = 1, 2, 3

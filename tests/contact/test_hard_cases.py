@@ -12,17 +12,13 @@ same numbers on 1 and 2 ranks.
 """
 from __future__ import annotations
 
-import importlib.util
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support import BENCHMARKS, load_script
 
-_path = Path(__file__).resolve().parent.parent / "benchmarks" / "hard_case_scenes.py"
-_spec = importlib.util.spec_from_file_location("hard_case_scenes", _path)
-scenes = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(scenes)
+scenes = load_script(BENCHMARKS / "hard_case_scenes.py")
 
 ALL_KINDS = scenes.ALL_KINDS
 

@@ -6,6 +6,8 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
+
 
 def jacobian_error(problem, rng_seed: int = 1) -> float:
     """‖(R(x + h dx) − R(x − h dx))/2h − J dx‖ / ‖J dx‖ at the current u."""
@@ -67,3 +69,24 @@ def convergence_order(r: np.ndarray) -> float:
     e = r / r[0]
     k = np.flatnonzero((e[1:] < 0.5 * e[:-1]) & (e[1:] > 1e-11))[-1] + 1
     return float(np.log(e[k]) / np.log(e[k - 1])) if k >= 2 else 0.0
+
+
+def energy_gradient_error(problem) -> float:
+    """|Π(u + h v) − Π(u − h v)|/2h against R_c·v: the residual is ∂Π/∂u."""
+    model = problem.gap_model
+    x0 = problem.u.vector.copy()
+    Rc = problem.contact.update(problem.bcs).residual
+    v = x0.duplicate()
+    v.array[:] = np.random.default_rng(5 + MPI.COMM_WORLD.rank).normal(size=v.array.shape)
+    fem.petsc.set_bc(v, problem.bcs, scale=0.0)
+    h = 1e-6 / v.norm()
+    energies = []
+    for sign in (1, -1):
+        x0.copy(problem.u.vector)
+        problem.u.vector.axpy(sign * h, v)
+        problem.u.x.scatter_forward()
+        energies.append(model.energy(nodal_displacement(problem.slave, problem.u)))
+    x0.copy(problem.u.vector)
+    problem.u.x.scatter_forward()
+    exact = Rc.dot(v)
+    return abs((energies[0] - energies[1]) / (2 * h) - exact) / abs(exact)

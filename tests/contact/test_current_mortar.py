@@ -8,9 +8,10 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactProblem
-from jacobian_check import convergence_order, jacobian_error, newton_history
-from test_finite_deformation import _energy_gradient_error
-from test_problem import LOCAL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks, load
+from support.jacobian_check import (convergence_order, energy_gradient_error, jacobian_error,
+                                    newton_history)
+from support import load_demo
+from support.scenes import LOCAL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks
 
 DUAL = ("LcLS*", "LcLS")
 
@@ -20,7 +21,7 @@ def _sheared_blocks(kind: str, scaling: str = "consistent", degree: int = 1,
     """The patch-test blocks, the upper one tilted, slid and bent into the lower
     one, the lower one waved: part of the interface in contact, every pair
     moved by a fair part of an element from where it started."""
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     domain, tags = demo.build_mesh(2, 0.09, 0.14, degree, comm)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", degree))
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
@@ -66,7 +67,7 @@ def test_differentiable_gaps_equal_the_kernels(kind, degree):
 @pytest.mark.parametrize("kind", LOCAL_KINDS)
 def test_current_mortar_residual_is_the_gradient_and_the_jacobian_is_exact(kind, scaling):
     problem = _sheared_blocks(kind, scaling)
-    assert _energy_gradient_error(problem) < 1e-8
+    assert energy_gradient_error(problem) < 1e-8
     assert jacobian_error(problem) < 1e-8
 
 
@@ -83,7 +84,7 @@ def test_missing_the_normal_linearization_is_detected():
     model = problem.gap_model
     exact = model.pair_gaps
     # the same direction both times (fixed seeds): only the normals' terms differ
-    exact_error = _energy_gradient_error(problem)
+    exact_error = energy_gradient_error(problem)
 
     def frozen_normals(values, pairs):
         """Neighbour nodes held at their values: the normals lose their derivatives."""
@@ -97,7 +98,7 @@ def test_missing_the_normal_linearization_is_detected():
     model.pair_gaps = frozen_normals
     # measured 3.3e-7 against 3e-10 serial; 9.8e-8 on one 2-rank partition, so
     # the bound is relative to the exact error, not absolute
-    frozen_error = _energy_gradient_error(problem)
+    frozen_error = energy_gradient_error(problem)
     assert frozen_error > 30 * exact_error, (exact_error, frozen_error)
 
 
@@ -112,7 +113,7 @@ def test_current_patch_test_error_is_the_penalty_penetration(kind):
     overhangs): two equilibria 5e-8 apart exist, both with residual 1e-15 in the
     serial model; Newton on 2 ranks can land on the other one (5.9e-6 at 1e3).
     Hence bounds, not equalities."""
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     deviations = []
     for penalty in ("1e3", "1e4"):
         args = demo.parse_args(["--basis-configuration", "current", "--penalty", penalty])
@@ -139,7 +140,7 @@ def test_current_mortar_newton_converges_quadratically():
     into pressures of order E. ContactProblem.solve therefore predicts each
     step on frozen surfaces and corrects on the current ones.
     """
-    demo = load("hertz2d")
+    demo = load_demo("hertz2d")
     args = demo.parse_args(["--refine", "0.4", "--obstacle", "elastic"])
     domain, tags, h = demo.build_mesh(args, demo.hertz(args)["a"], MPI.COMM_WORLD)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
@@ -157,7 +158,7 @@ def test_previous_configuration_reports_the_model_it_solved_with():
     the solution never saw: p0 65x Hertz, contact force 7.8x the load on an
     elastic block, because the frozen pairing misses the slide of the slave
     over the indented master within a step."""
-    figures = load("hertz2d").main(["--obstacle", "elastic", "--basis-configuration",
+    figures = load_demo("hertz2d").main(["--obstacle", "elastic", "--basis-configuration",
                                     "previous", "--refine", "0.5"])
     assert abs(figures["p0_error"]) < 0.03
     assert abs(figures["force_error"]) < 2e-3
@@ -167,7 +168,7 @@ def test_previous_configuration_reports_the_model_it_solved_with():
 def test_hertz2d_elastic_current_is_close_to_hertz():
     """Small-strain Hertz theory against a solution on the current surfaces
     (strains of about 6%): within a few percent, and balanced."""
-    figures = load("hertz2d").main(["--obstacle", "elastic", "--basis-configuration",
+    figures = load_demo("hertz2d").main(["--obstacle", "elastic", "--basis-configuration",
                                     "current", "--refine", "0.5"])
     assert abs(figures["p0_error"]) < 0.03
     assert abs(figures["a_error"]) < 0.02
@@ -184,7 +185,7 @@ def test_current_mortar_same_figures_on_one_and_all_ranks():
 
 def _sheared_boxes(kind: str, scaling: str = "consistent") -> ContactProblem:
     """The 3D patch-test boxes (coarse), bent, twisted and slid into each other."""
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     domain, tags = demo.build_mesh(3, 0.25, 0.35, 1, MPI.COMM_WORLD)
     V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
@@ -224,13 +225,13 @@ def test_current_mortar_3d_is_the_kernel_and_its_exact_derivatives(kind, scaling
     n = problem.slave.layout.num_owned
     assert comm.allreduce(int(np.sum(state.gaps[:n] > 0))) > 0
     assert comm.allreduce(int(np.sum(state.gaps[:n] < 0))) > 0
-    assert _energy_gradient_error(problem) < 1e-8
+    assert energy_gradient_error(problem) < 1e-8
     assert jacobian_error(problem) < 1e-8
 
 
 @pytest.mark.slow
 def test_current_mortar_3d_patch_test():
-    demo = load("patch_test")
+    demo = load_demo("patch_test")
     args = demo.parse_args(["--dim", "3", "--fine", "0.25", "--coarse", "0.35",
                             "--basis-configuration", "current"])
     r = demo.run(args, "finer-slave", "LcLS*", "consistent")
@@ -242,7 +243,7 @@ def test_jet_clipping_conserves_the_area_of_near_coincident_triangles():
     equal up to vertex moves of 1e-16 … 1e-9 overlap in the triangle, up to the
     tolerance times the perimeter (crossings extrapolated off their edges gave
     up to several times its area before)."""
-    from dolfinx_mortar.contact.current_mortar_3d import _signed_area, clip_polygon
+    from dolfinx_mortar.contact.current_mortar_3d import signed_area, clip_polygon
     from dolfinx_mortar.contact.jet import Jet
     rng = np.random.default_rng(3)
     tolerance, worst = 1e-10, 0.0
@@ -257,7 +258,7 @@ def test_jet_clipping_conserves_the_area_of_near_coincident_triangles():
         v = Jet.variables(np.concatenate([a, b]).reshape(1, -1))
         points = [[v[2 * i], v[2 * i + 1]] for i in range(6)]
         clipped = clip_polygon(points[:3], points[3:], tolerance)
-        area = float(_signed_area(clipped).value[0]) if len(clipped) >= 3 else 0.0
+        area = float(signed_area(clipped).value[0]) if len(clipped) >= 3 else 0.0
         exact = 0.5 * abs(np.cross(a[1] - a[0], a[2] - a[0]))
         perimeter = np.sum(np.linalg.norm(a - np.roll(a, 1, axis=0), axis=1))
         worst = max(worst, abs(area - exact) / ((tolerance + move) * perimeter))
@@ -270,4 +271,4 @@ def test_jet_clipping_conserves_the_area_of_near_coincident_triangles():
     subject, box = points[:3], points[3:]
     clipped = clip_polygon(subject, box, tolerance)
     assert min(float(p[0].value[0]) for p in clipped) >= -1e-9
-    assert abs(float(_signed_area(clipped).value[0]) - 0.5) <= 1e-9
+    assert abs(float(signed_area(clipped).value[0]) - 0.5) <= 1e-9

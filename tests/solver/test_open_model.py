@@ -7,7 +7,6 @@ obstacles, the contact resultant and the reactions.
 """
 from __future__ import annotations
 
-import importlib.util
 import warnings
 from pathlib import Path
 
@@ -16,7 +15,7 @@ import pytest
 import ufl
 from dolfinx import fem
 from dolfinx.nls.petsc import NewtonSolver
-from meshes import rectangle
+from support.meshes import rectangle
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -25,18 +24,11 @@ from dolfinx_mortar import (ContactDivergenceError, ContactProblem, ContactTerm,
                             reaction_force)
 from dolfinx_mortar.io.read_series import read_xdmf_series
 from dolfinx_mortar.solver.elastic import linear_elastic_residual
+from support import load_demo
 
 BOTTOM, TOP, LEFT = 1, 2, 3
 E, NU, H = 1.0, 0.3, 0.5
 E_PLANE = E / (1 - NU ** 2)   # plane strain, free sideways
-
-
-def load_demo(name: str):
-    path = Path(__file__).resolve().parents[1] / "demos" / f"{name}.py"
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def block(n=(8, 4), degree=1):
@@ -223,3 +215,31 @@ def test_contact_term_refuses_bad_input():
     with pytest.raises(ValueError, match="without '-'"):
         LoadPathSolver(NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact),
                        petsc_options={"-snes_max_it": 3}).solve(lambda t: None)
+
+
+@pytest.mark.parametrize("predictor", ["none", "linear"])
+def test_linear_predictor_starts_a_linear_path_at_its_solution(predictor):
+    """On a path whose solution is linear in t (the plane moved up at a constant
+    rate, the contact already closed), the linear predictor lands on the
+    solution of every step after the second: Newton has nothing left to do."""
+    domain, tags, V = block()
+    u = fem.Function(V)
+    plane = RigidPlane([0.0, 0.0], [0.0, 1.0])
+    contact = ContactTerm(u, tags, BOTTOM, obstacle=plane, kind="LcLS*", penalty=1e3)
+    bcs = [dirichlet(V, tags, LEFT, 0, 0.0), dirichlet(V, tags, TOP, 1, 0.0)]
+    problem = NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact, bcs)
+    forces = []
+    result = LoadPathSolver(problem).solve(
+        lambda t: plane.move_to([0.0, 0.01 * (1 + t)]), load_steps=5, predictor=predictor,
+        on_step=lambda step: forces.append(contact.contact_force()[1]))
+    assert forces == pytest.approx([uniform_pressure(0.01 * (1 + t), 1e3)
+                                    for t in (0.2, 0.4, 0.6, 0.8, 1.0)], rel=1e-8)
+    iterations = [step.newton_iterations for step in result.steps]
+    if predictor == "linear":
+        assert iterations[2:] == [0, 0, 0]
+    else:
+        assert min(iterations[2:]) >= 1
+    for step in result.steps:
+        assert step.reference > 0 and step.floor < 1e-7 * step.reference
+    with pytest.raises(ValueError, match="predictor"):
+        LoadPathSolver(problem).solve(lambda t: None, predictor="quadratic")

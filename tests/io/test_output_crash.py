@@ -22,11 +22,11 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.obstacles import RigidPlane
 from dolfinx_mortar import ContactProblem
 from dolfinx_mortar.io.surface_output import surface_output_path
-from test_problem import block_on_plane
+from support import REPO_ROOT
+from support.scenes import block_on_plane
 
 CHILD = Path(__file__).resolve().parent / "output_child.py"
 STEPS = 200
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def read_series(index: Path) -> Optional[int]:
@@ -99,7 +99,7 @@ def child_environment() -> dict:
     child of an mpirun rank would otherwise try to join that job)."""
     env = {k: v for k, v in os.environ.items()
            if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "HYDRA_", "PMI_"))}
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO_ROOT), env.get("PYTHONPATH")]))
     env["OMP_NUM_THREADS"] = "1"
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     return env

@@ -4,8 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
-from dolfinx_mortar.surfaces.structured import (compact_nodes, flat_line, flat_patch,  # noqa: F401
-                                       lattice_cells, line_chain)
+from dolfinx_mortar.surfaces.structured import compact_nodes, lattice_cells, line_chain
 
 
 def curved_line(degree: int, n: int = 7, seed: int = 0) -> LagrangeSurface:
