@@ -36,7 +36,7 @@ KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 CONFIGURATIONS = ("initial", "previous", "current")
 COLUMNS = ("kind", "configuration", "status", "tangential_oscillation", "tangential_std",
            "tangential_mean", "normal_oscillation", "normal_mean", "newton_iterations",
-           "max_newton_per_step", "max_quadratic_constant", "load_steps", "requested_steps", "wall_time", "dofs", "h",
+           "max_newton_per_step", "max_terminal_iterations", "load_steps", "requested_steps", "wall_time", "dofs", "h",
            "reason")
 
 
@@ -106,12 +106,12 @@ def markdown_table(rows: list[dict], args: argparse.Namespace) -> str:
         "past 2 element lengths of "
         "slide; F_t, N: tangential and normal force on the obstacle, relative to the mean "
         "normal force N over the slide distance. Steps: converged (requested); more "
-        "converged than requested means cut steps. C: the largest e_k+1 / e_k² at the last "
-        "Newton iterate of a step (e: residual / out-of-balance force of the step); "
-        "order one is quadratic convergence.",
+        "converged than requested means cut steps. n: the most Newton iterations a step took "
+        "after its residual fell to 1e-3 of the step's out-of-balance force (quadratic "
+        "convergence: 2–3; a linear rate of 0.1: 8).",
         "",
         "| kind | configuration | status | F_t max−min / N | F_t std / N | F_t mean / N "
-        "| N max−min / N | N | Newton (max/step) | C | steps (requested) | wall s | note |",
+        "| N max−min / N | N | Newton (max/step) | n | steps (requested) | wall s | note |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -124,7 +124,7 @@ def markdown_table(rows: list[dict], args: argparse.Namespace) -> str:
             f"| {fmt(r.get('tangential_oscillation'), '.2e')} "
             f"| {fmt(r.get('tangential_std'), '.2e')} | {fmt(r.get('tangential_mean'), '+.2e')} "
             f"| {fmt(r.get('normal_oscillation'), '.2e')} | {fmt(r.get('normal_mean'), '.5f')} "
-            f"| {newton} | {fmt(r.get('max_quadratic_constant'), '.2g')} | {steps} | {r['wall_time']:.1f} | {r.get('reason') or ''} |")
+            f"| {newton} | {fmt(r.get('max_terminal_iterations'), 'd')} | {steps} | {r['wall_time']:.1f} | {r.get('reason') or ''} |")
     return "\n".join(lines)
 
 

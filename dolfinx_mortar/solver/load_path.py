@@ -174,8 +174,7 @@ class LoadPathSolver:
                     states = [term.evaluate() for term in self.contacts]
                     active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
                     step = StepResult(target, iterations, history,
-                                      time.perf_counter() - clock, active, phases, reference,
-                                      self.equilibrium.floor_rtol * reference)
+                                      time.perf_counter() - clock, active, phases, reference)
                     result.steps.append(step)
                     before = stepper.fraction_of_steps
                     stepper.succeeded()

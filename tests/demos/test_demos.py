@@ -106,9 +106,10 @@ def test_press_and_slide_frictionless_sliding_needs_no_tangential_force(out):
     assert figures["normal_oscillation"] < 6e-2
     pressed = [r["normal_force"] for r in steps if r["phase"] == "press"][-1]
     assert figures["normal_mean"] == pytest.approx(pressed, rel=5e-2)
-    # Newton ends every step quadratically: e_k+1 = C e_k² with C ≤ 29 measured;
-    # a linear rate of 0.1 from e_k = 1e-5 would give C = 1e4
-    assert figures["max_quadratic_constant"] < 1e3
+    # Newton ends every step quadratically: from 1e-3 of the step's force to
+    # convergence in at most 3 iterations (measured: 3 on 1 and 2 ranks); a
+    # linear rate of 0.1 would need 8
+    assert figures["max_terminal_iterations"] <= 3
     if MPI.COMM_WORLD.rank == 0:
         assert len(csv_path.read_text().splitlines()) == len(steps) + 1
         assert png_path.stat().st_size > 10_000

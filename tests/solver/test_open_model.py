@@ -240,6 +240,8 @@ def test_linear_predictor_starts_a_linear_path_at_its_solution(predictor):
     else:
         assert min(iterations[2:]) >= 1
     for step in result.steps:
-        assert step.reference > 0 and step.floor < 1e-7 * step.reference
+        # a linear problem (the active set does not change): one Newton step
+        # from the step's start reaches round-off
+        assert step.reference > 0 and step.terminal_iterations() == 0
     with pytest.raises(ValueError, match="predictor"):
         LoadPathSolver(problem).solve(lambda t: None, predictor="quadratic")

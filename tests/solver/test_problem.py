@@ -481,8 +481,8 @@ def test_gls_first_touch_starts_from_the_closed_gap(kind):
     attempts = []
     newton = problem.solver.newton_step
 
-    def counted(snes, x):
-        outcome = newton(snes, x)
+    def counted(snes, x, *predictor):
+        outcome = newton(snes, x, *predictor)
         attempts.append(outcome[2])
         return outcome
     problem.solver.newton_step = counted
