@@ -24,9 +24,9 @@ from mpi4py import MPI
 
 from dolfinx_mortar.demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
                                 solver_demo_parser)
+from dolfinx_mortar.demo_support.hertz_meshes import (FIXED, LOAD, MASTER, SLAVE, SYMMETRY,
+                                                      quarter_disk_mesh)
 from dolfinx_mortar.io.output import write_json
-
-SLAVE, MASTER, SYMMETRY, LOAD, FIXED = 1, 2, 3, 4, 5
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
@@ -60,48 +60,9 @@ def hertz(args) -> dict:
 
 def build_mesh(args, a: float, comm: MPI.Comm):
     """Quarter disk (and block), graded towards the contact point (0, 0)."""
-    import gmsh
-    from dolfinx.io import gmshio
-    from dolfinx_mortar.io.gmsh_io import grade_towards_point
-    R = args.radius
     h_contact = a / (40 * args.refine)
-    gmsh.initialize(["", "-v", "0"])
-    try:
-        if comm.rank == 0:
-            occ = gmsh.model.occ
-            disk = occ.addDisk(0, R, 0, R, R)
-            box = occ.addRectangle(0, 0, 0, R, R)
-            quarter, _ = occ.intersect([(2, disk)], [(2, box)])
-            surfaces = [quarter[0][1]]
-            if args.obstacle == "elastic":
-                surfaces.append(occ.addRectangle(0, -2 * R, 0, 2 * R, 2 * R))
-            occ.synchronize()
-            tags: dict = {SLAVE: [], MASTER: [], SYMMETRY: [], LOAD: [], FIXED: []}
-            tol = 1e-6 * R
-            for _, curve in gmsh.model.getEntities(1):
-                x, y, _ = occ.getCenterOfMass(1, curve)
-                if abs(x) < tol:
-                    tags[SYMMETRY].append(curve)      # x = 0 of cylinder and block
-                elif abs(y - R) < tol:
-                    tags[LOAD].append(curve)
-                elif abs(y) < tol:
-                    tags[MASTER].append(curve)        # top of the block
-                elif abs(y + 2 * R) < tol:
-                    tags[FIXED].append(curve)
-                elif y > 0:
-                    tags[SLAVE].append(curve)         # the arc
-            for tag, curves in tags.items():
-                if curves:
-                    gmsh.model.addPhysicalGroup(1, curves, tag)
-            for i, s in enumerate(surfaces):
-                gmsh.model.addPhysicalGroup(2, [s], 10 + i)
-            grade_towards_point((0, 0, 0), h_contact, R / 8, 1.5 * a, 1.5 * a + 40 * (R / 8))
-            gmsh.model.mesh.generate(2)
-            if args.degree == 2:
-                gmsh.model.mesh.setOrder(2)
-        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    finally:
-        gmsh.finalize()
+    lower = "block" if args.obstacle == "elastic" else "none"
+    domain, facet_tags = quarter_disk_mesh(args.radius, a, h_contact, lower, args.degree, comm)
     return domain, facet_tags, h_contact
 
 

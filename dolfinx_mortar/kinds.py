@@ -16,6 +16,9 @@ KIND_NAMES: tuple[str, ...] = tuple(_kernels.to_string(k) for k in _kernels.all_
 
 KindLike = Union[str, BasisKind]
 
+#: The dual (biorthogonal) kinds: element-wise, discontinuous, negative in part.
+DUAL_KINDS = (BasisKind.LcLS_star, BasisKind.LcLS)
+
 
 def parse_kind(kind: KindLike) -> BasisKind:
     """Return the :class:`BasisKind` for a name, an alias or a kind.

@@ -26,7 +26,7 @@ from dolfinx_mortar import _kernels
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.layout import MassMatrixSolver
 from dolfinx_mortar.surfaces.tabulation import Tabulation
-from dolfinx_mortar.tolerance import length_scale
+from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 FieldLike = Union[Callable[[FloatArray], FloatArray], FloatArray]
@@ -75,8 +75,15 @@ class MortarBasis:
         gdim = tab.points.shape[2]
         scale = length_scale(tab.points.reshape(-1, gdim), self.layout.comm)
         try:
-            _kernels.check_element_measures(self.element_weights, tab.points, surface.tdim,
-                                            scale)
+            geometric = (self.element_weights if tab.geometric_weights is None
+                         else _kernels.element_integrals(tab.phi, tab.geometric_weights))
+            _kernels.check_element_measures(geometric, tab.points, surface.tdim, scale)
+            if tab.geometric_weights is not None:
+                # every rank raises, so that none waits in a collective
+                messages = self.layout.comm.allgather(
+                    _on_axis_message(self.element_weights, geometric, scale))
+                if any(messages):
+                    raise ValueError(next(m for m in messages if m))
             _kernels.check_lumped_weights(self.kind, self.element_weights, nodal_at_cells)
             if is_global(self.kind):
                 self.coefficients = None
@@ -164,6 +171,19 @@ class MortarBasis:
         np.add.at(out, (rows, self.cells[cells].ravel()), phi.ravel())
         M = np.array([self.mass_solver.solve(row) for row in out])  # M = N L⁻¹ (L = Lᵀ)
         return M * self.lumped_weights[None, :] if self.kind == BasisKind.GLS_star else M
+
+
+def _on_axis_message(weighted: FloatArray, geometric: FloatArray,
+                     scale: float) -> Optional[str]:
+    """An axisymmetric facet on the axis (r = 0 all along) sweeps no surface:
+    its measure ∫2πr ds is zero against its length times the geometry's scale."""
+    swept = weighted.sum(axis=1)
+    on_axis = swept <= zero_length(scale) * 2 * np.pi * geometric.sum(axis=1)
+    if not np.any(on_axis):
+        return None
+    c = int(np.flatnonzero(on_axis)[0])
+    return (f"slave facet {c} lies on the axis r = 0: as an axisymmetric surface it sweeps "
+            "no area (tag only the facets that touch)")
 
 
 def _hint(surface: Any) -> str:

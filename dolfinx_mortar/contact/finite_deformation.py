@@ -34,14 +34,13 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.gaps import GapModelBase
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
-from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, is_partition_of_unity, kind_name
+from dolfinx_mortar.kinds import DUAL_KINDS, KindLike, is_global, is_partition_of_unity, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 
 FloatArray = npt.NDArray[np.float64]
 
-DUAL_KINDS = (BasisKind.LcLS_star, BasisKind.LcLS)
 
 
 def area_element_derivatives(F: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:

@@ -15,12 +15,12 @@ import numpy.typing as npt
 from mpi4py import MPI
 
 from dolfinx_mortar.contact.current_mortar import CurrentMortarGap
-from dolfinx_mortar.contact.finite_deformation import DUAL_KINDS, CurrentObstacleGap
+from dolfinx_mortar.contact.finite_deformation import CurrentObstacleGap
 from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap, gap_kind
 from dolfinx_mortar.contact.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.state import GapModel
-from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, parse_kind
+from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, is_global, parse_kind
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
@@ -42,11 +42,13 @@ class ContactOptions:
     basis_configuration: str = "initial"
     boundary_modification: bool = False
     search_radius: Optional[float] = None
+    axisymmetric: bool = False
 
     @classmethod
     def checked(cls, kind: KindLike, penalty: float, scaling: str, active_set: str,
                 basis_configuration: str, boundary_modification: bool,
-                search_radius: Optional[float], elastic_master: bool) -> "ContactOptions":
+                search_radius: Optional[float], elastic_master: bool,
+                axisymmetric: bool = False) -> "ContactOptions":
         gap_kind(kind, scaling)  # names an unknown kind or scaling
         kind = parse_kind(kind)
         if not (isinstance(penalty, (int, float, np.floating, np.integer))
@@ -63,6 +65,11 @@ class ContactOptions:
         if basis_configuration == "current" and active_set == "pointwise":
             raise NotImplementedError("basis_configuration='current' is implemented for the "
                                       "nodal active set only")
+        if basis_configuration == "current" and axisymmetric:
+            raise NotImplementedError("basis_configuration='current' with axisymmetric=True: "
+                                      "the measure 2πr ds moves with u_r and its "
+                                      "linearization is not implemented; use 'initial' or "
+                                      "'previous'")
         if boundary_modification and not (elastic_master and kind in DUAL_KINDS):
             raise ValueError("the consistent boundary modification applies to the dual kinds "
                              "(LcLS*, LcLS) with an elastic master (master_tag)")
@@ -76,7 +83,7 @@ class ContactOptions:
                           RuntimeWarning, stacklevel=4)
         return cls(kind, float(penalty), scaling, active_set, basis_configuration,
                    bool(boundary_modification),
-                   None if search_radius is None else float(search_radius))
+                   None if search_radius is None else float(search_radius), bool(axisymmetric))
 
 
 def current_model(options: ContactOptions, slave: LagrangeSurface,

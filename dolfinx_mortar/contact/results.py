@@ -25,6 +25,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.kinds import DUAL_KINDS
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 
 FloatArray = npt.NDArray[np.float64]
@@ -84,7 +85,7 @@ class ContactResults:
     def _node_lengths(self) -> FloatArray:
         """Each local slave node's element length: the largest of its cells'."""
         slave = self.slave
-        cell_length = slave.tabulate().weights.sum(axis=1) ** (1.0 / slave.tdim)
+        cell_length = slave.tabulate().ds_weights.sum(axis=1) ** (1.0 / slave.tdim)
         length = np.zeros(slave.layout.size_local)
         np.maximum.at(length, slave.cells, np.repeat(cell_length[:, None],
                                                      slave.cells.shape[1], axis=1))
@@ -108,10 +109,20 @@ class ContactResults:
                  if n else (-np.inf, 0.0, []))
         ratio, gap, x = max(self.mesh.comm.allgather(local), key=lambda item: item[0])
         if ratio > DEEP_PENETRATION:
+            hint = ""
+            options = self.options
+            if (self.master is not None and options.kind in DUAL_KINDS
+                    and not options.boundary_modification):
+                # the dual functions are negative near the far node of a facet:
+                # a facet covered only there by the master "sees" a penetration
+                hint = ("; or, with a dual kind against an elastic master, a slave facet only "
+                        "partly covered by the master (at the edge of the search radius or "
+                        "of the master) shows a false penetration: pass "
+                        "boundary_modification=True")
             warnings.warn(f"the initial configuration penetrates by {gap:.3g} ({ratio:.3g} "
                           f"slave element lengths) at the slave node {x}: check the "
-                          "obstacle's position and normal, or the tags of slave and master",
-                          RuntimeWarning, stacklevel=3)
+                          "obstacle's position and normal, or the tags of slave and master"
+                          + hint, RuntimeWarning, stacklevel=3)
 
     def slip(self, state: Optional[ContactState] = None) -> float:
         """The largest tangential slip of an active slave node since the bases
@@ -125,7 +136,7 @@ class ContactResults:
         slave = self.slave
         u_nodes = nodal_displacement(slave, self.u)
         other = self._partner_displacement(u_nodes)
-        measure = slave.tabulate().weights.sum(axis=1)
+        measure = slave.tabulate().ds_weights.sum(axis=1)
         weighted = slave.cell_normals() * measure[:, None, None]
         normals = np.stack([slave.layout.sum_at_functions(slave.cells, weighted[..., k])
                             for k in range(slave.gdim)], axis=1)

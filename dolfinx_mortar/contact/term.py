@@ -85,6 +85,12 @@ class ContactTerm(ContactResults):
     search_radius
         How far apart slave and master facets may be and still be paired
         (default the largest slave facet diameter).
+    axisymmetric
+        The mesh is the (r, z) half-plane r ≥ 0 of a body of revolution (x the
+        radius, y the axis): every contact integral carries 2πr, so that
+        forces are those on the whole body (DESIGN.md §7). The user's bulk form
+        must be axisymmetric too
+        (:func:`~dolfinx_mortar.solver.elastic.axisymmetric_elastic_residual`).
     """
 
     def __init__(self, u: fem.Function, facet_tags, slave_tag: int, *,
@@ -92,7 +98,7 @@ class ContactTerm(ContactResults):
                  kind: KindLike = "LcLS*", penalty: float, scaling: str = "consistent",
                  active_set: str = "nodal", basis_configuration: str = "initial",
                  quadratic_transform: bool = False, boundary_modification: bool = False,
-                 search_radius: Optional[float] = None):
+                 search_radius: Optional[float] = None, axisymmetric: bool = False):
         if not isinstance(u, fem.Function):
             raise TypeError(f"u must be a dolfinx.fem.Function (the displacement), got "
                             f"{type(u).__name__}")
@@ -109,14 +115,17 @@ class ContactTerm(ContactResults):
                              "does not fit the mesh's dimension")
         self.options = ContactOptions.checked(kind, penalty, scaling, active_set,
                                               basis_configuration, boundary_modification,
-                                              search_radius, master_tag is not None)
+                                              search_radius, master_tag is not None,
+                                              axisymmetric)
+        if axisymmetric and gdim != 2:
+            raise ValueError(f"axisymmetric contact needs a 2D (r, z) mesh, got a {gdim}D one")
         check_cells(mesh)
         check_contact_tags(mesh, facet_tags, slave_tag, master_tag)
         self.u, self.V, self.mesh = u, V, mesh
         self.obstacle = obstacle
-        self.slave = facet_surface(V, facet_tags, slave_tag, quadratic_transform)
-        self.master = (facet_surface(V, facet_tags, master_tag) if master_tag is not None
-                       else None)
+        self.slave = facet_surface(V, facet_tags, slave_tag, quadratic_transform, axisymmetric)
+        self.master = (facet_surface(V, facet_tags, master_tag, axisymmetric=axisymmetric)
+                       if master_tag is not None else None)
         #: wall times of the contact work by part, seconds (accumulated)
         self.timings: dict[str, float] = {}
         self.state: Optional[ContactState] = None

@@ -170,6 +170,9 @@ class MortarCoupling:
         if slave.tdim != slave.gdim - 1 or master.tdim != master.gdim - 1:
             raise ValueError("contact surfaces must be facets: lines in 2D, "
                              "triangles or quadrilaterals in 3D")
+        if getattr(slave, "axisymmetric", False) != getattr(master, "axisymmetric", False):
+            raise ValueError("slave and master must both be axisymmetric (r, z) surfaces, or "
+                             "neither")
         self.slave, self.master = slave, master
         #: wall time in seconds of each phase on this rank
         self.timings: dict[str, float] = {}
@@ -214,7 +217,8 @@ class MortarCoupling:
                                       master.facet_type, master_copy.x, master_copy.cells,
                                       candidates, points, weights, opposing_normals_only,
                                       length_scale=self.length_scale,
-                                      keep_points=keep_points)
+                                      keep_points=keep_points,
+                                      axisymmetric=slave.axisymmetric)
         self._raise_on_degenerate_facets(r, xs, slave_cells, master_copy)
         self.timings["segmentation"] = time.perf_counter() - clock
         self.num_candidates = len(candidates)

@@ -23,6 +23,7 @@ from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.input_checks import check_boundary_data, check_tags
 from dolfinx_mortar.kinds import KindLike
+from dolfinx_mortar.solver.axisymmetric import axisymmetric_elastic_residual, circumference
 from dolfinx_mortar.solver.load_path import LoadPathSolver, SolveResult, StepResult
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem, reaction_force
 
@@ -63,6 +64,11 @@ class ContactProblem:
         ``{tag: vector}``: surface tractions at load factor 1.
     petsc_options
         Options of the solver (:class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`).
+    axisymmetric
+        V lives on the (r, z) half-plane of a body of revolution: the bulk is
+        :func:`~dolfinx_mortar.solver.axisymmetric.axisymmetric_elastic_residual`,
+        tractions act on the swept surfaces (∫ t·v 2πr ds) and the contact
+        term is axisymmetric; forces are those on the whole body.
     """
 
     def __init__(self, V: fem.FunctionSpace, facet_tags, slave_tag: int, *,
@@ -72,7 +78,8 @@ class ContactProblem:
                  basis_configuration: str = "initial",
                  fixed: Optional[dict] = None, tractions: Optional[dict] = None,
                  quadratic_transform: bool = False, boundary_modification: bool = False,
-                 search_radius: Optional[float] = None, petsc_options: Optional[dict] = None):
+                 search_radius: Optional[float] = None, petsc_options: Optional[dict] = None,
+                 axisymmetric: bool = False):
         mesh = V.mesh
         gdim = mesh.geometry.dim
         if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
@@ -91,14 +98,21 @@ class ContactProblem:
             self.u, facet_tags, slave_tag, master_tag=master_tag, obstacle=obstacle,
             kind=kind, penalty=penalty, scaling=scaling, active_set=active_set,
             basis_configuration=basis_configuration, quadratic_transform=quadratic_transform,
-            boundary_modification=boundary_modification, search_radius=search_radius)
+            boundary_modification=boundary_modification, search_radius=search_radius,
+            axisymmetric=axisymmetric)
         #: the load factor, 0 … 1
         self.load = fem.Constant(mesh, PETSc.ScalarType(0.0))
         v = ufl.TestFunction(V)
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
-        F = linear_elastic_residual(self.u, E, nu)
+        if axisymmetric:
+            F = axisymmetric_elastic_residual(self.u, E, nu)
+            weight = circumference(mesh)
+        else:
+            F = linear_elastic_residual(self.u, E, nu)
+            weight = 1.0
         for tag, t in tractions.items():
-            F -= self.load * ufl.inner(ufl.as_vector([float(c) for c in t]), v) * ds(tag)
+            F -= (self.load * ufl.inner(ufl.as_vector([float(c) for c in t]), v) * weight
+                  * ds(tag))
         fdim = mesh.topology.dim - 1
         self._bc_values = []
         self.bcs = []

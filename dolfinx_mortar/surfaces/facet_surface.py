@@ -23,7 +23,8 @@ _FACET_CELL = {"interval": "point", "triangle": "interval",
 
 def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
                   facet_tags: dolfinx.mesh.MeshTagsMetaClass, tag: int,
-                  quadratic_transform: bool = False) -> LagrangeSurface:
+                  quadratic_transform: bool = False,
+                  axisymmetric: bool = False) -> LagrangeSurface:
     """The surface of the facets marked ``tag``, owned by this rank.
 
     Facet nodes are ordered so that the natural normal of every facet points
@@ -41,6 +42,9 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
         The value marking the slave facets.
     quadratic_transform
         Use the transformed quadratic basis on quadratic triangle facets.
+    axisymmetric
+        The mesh is an (r, z) half-plane: integrate with 2πr ds
+        (:class:`~dolfinx_mortar.surfaces.lagrange.LagrangeSurface`).
 
     Raises
     ------
@@ -98,7 +102,8 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     x = space.tabulate_dof_coordinates()[:, :gdim]
     facet_cell = _FACET_CELL[mesh.topology.cell_type.name]
     surface = LagrangeSurface(facet_cell, degree, x, cells, layout=layout,
-                              quadratic_transform=quadratic_transform)
+                              quadratic_transform=quadratic_transform,
+                              axisymmetric=axisymmetric)
     if len(cells) == 0:
         return surface
     # Outward: the facet normal must point away from its cell's centroid.

@@ -170,11 +170,16 @@ class LagrangeSurface:
         How the nodes are distributed; ``None`` means serial.
     serendipity, quadratic_transform
         See :class:`ReferenceLagrange`.
+    axisymmetric
+        Lines in the (r, z) half-plane r ≥ 0 standing for the surfaces they
+        sweep about the axis r = 0: every integral is taken with the measure
+        2πr ds (DESIGN.md §7).
     """
 
     def __init__(self, cell: str, degree: int, x: npt.ArrayLike, cells: npt.ArrayLike,
                  layout: Optional[NodeLayout] = None, serendipity: bool = False,
-                 quadratic_transform: bool = False, check_cells: bool = True):
+                 quadratic_transform: bool = False, check_cells: bool = True,
+                 axisymmetric: bool = False):
         self.reference = ReferenceLagrange(cell, degree, serendipity, quadratic_transform)
         self.x = np.asarray(x, dtype=np.float64)
         self.cells = np.asarray(cells, dtype=np.int64)
@@ -193,11 +198,28 @@ class LagrangeSurface:
                              f"{self.layout.size_local} local nodes")
         if len(self.cells) and (self.cells.min() < 0 or self.cells.max() >= len(self.x)):
             raise ValueError("cell node indices out of range")
-        self.description = self.reference.name
         self.tdim = self.reference.tdim
         self.gdim = self.x.shape[1]
-        if check_cells:
+        self.axisymmetric = bool(axisymmetric)
+        self.description = self.reference.name + (" (axisymmetric)" if axisymmetric else "")
+        if check_cells:  # collective: callers that skip it may call on some ranks only
+            if axisymmetric:
+                self._check_half_plane()
             self._check_degenerate_cells()
+
+    def _check_half_plane(self) -> None:
+        """Axisymmetric surfaces are lines in r ≥ 0: a node at r < 0 (beyond
+        round-off, judged against the geometry's scale) is a mesh on the wrong
+        side of the axis, or not an (r, z) mesh at all."""
+        if self.gdim != 2 or self.tdim != 1:
+            raise ValueError(f"axisymmetric surfaces are lines in the (r, z) plane, got "
+                             f"{self.reference.name} facets in {self.gdim}D")
+        comm = self.layout.comm
+        scale = length_scale(self.x, comm)
+        r_min = min(comm.allgather(float(np.min(self.x[:, 0], initial=np.inf))))
+        if r_min < -zero_length(scale):
+            raise ValueError(f"axisymmetric surface with a node at r = {r_min:.6g} < 0: the "
+                             "(r, z) mesh must lie in r ≥ 0 (x is the radius, y the axis)")
 
     def _check_degenerate_cells(self) -> None:
         """Refuse facets of zero size, and triangles or quadrilaterals of zero
@@ -260,7 +282,8 @@ class LagrangeSurface:
         return LagrangeSurface(self.reference.cell, self.reference.degree,
                                self.x + displacement, self.cells, layout=self.layout,
                                serendipity=self.reference.serendipity,
-                               quadratic_transform=self.reference.transform is not None)
+                               quadratic_transform=self.reference.transform is not None,
+                               axisymmetric=self.axisymmetric)
 
     def reflected(self, which: npt.ArrayLike) -> "LagrangeSurface":
         """The same surface with the cells marked in ``which`` reflected (normal flipped)."""
@@ -271,7 +294,7 @@ class LagrangeSurface:
         return LagrangeSurface(self.reference.cell, self.reference.degree, self.x, cells,
                                layout=self.layout, serendipity=self.reference.serendipity,
                                quadratic_transform=self.reference.transform is not None,
-                               check_cells=False)
+                               check_cells=False, axisymmetric=self.axisymmetric)
 
     @property
     def num_elements(self) -> int:
@@ -297,7 +320,7 @@ class LagrangeSurface:
         coords = self.x[self.cells[cells]]  # (n, nd, gdim)
         x = np.einsum("nk,nkg->ng", N_geo, coords)
         tangents = [np.einsum("nk,nkg->ng", dN[:, t, :], coords) for t in range(self.tdim)]
-        return N, x, measure_from_tangents(tangents)
+        return N, x, measure_from_tangents(tangents) * self.radial_factor(x)
 
     def tabulate(self, quadrature_degree: Optional[int] = None,
                  transformed: bool = True) -> Tabulation:
@@ -315,11 +338,21 @@ class LagrangeSurface:
         # matmul broadcasts over cells and is several times faster than einsum here
         points = N_geo @ coords
         tangents = [dN[:, t, :] @ coords for t in range(self.tdim)]  # (nc, nq, gdim) each
-        measure = measure_from_tangents(tangents)
+        ds = measure_from_tangents(tangents) * wq[None, :]
         nc, nq = len(self.cells), len(X)
         phi = np.broadcast_to(N, (nc, nq, N.shape[1]))
-        return Tabulation(phi=np.ascontiguousarray(phi), weights=measure * wq[None, :],
-                          points=points)
+        if not self.axisymmetric:
+            return Tabulation(phi=np.ascontiguousarray(phi), weights=ds, points=points)
+        return Tabulation(phi=np.ascontiguousarray(phi), weights=ds * self.radial_factor(points),
+                          points=points, geometric_weights=ds)
+
+    def radial_factor(self, x: FloatArray) -> FloatArray:
+        """The factor of the measure at points x (..., gdim): 2πr on an
+        axisymmetric surface (r clamped at 0: an axis node may sit at −1e-17),
+        else 1."""
+        if not self.axisymmetric:
+            return np.ones(x.shape[:-1])
+        return 2 * np.pi * np.maximum(x[..., 0], 0.0)
 
     def locate(self, points):
         """Lagrange surfaces take evaluation points as ``(cells, X_reference)``."""

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 import numpy.typing as npt
@@ -16,14 +17,24 @@ class Tabulation:
     phi
         N_i(x_q) of the element's local functions, shape (cells, points, functions).
     weights
-        Quadrature weight times the surface Jacobian |J|, shape (cells, points).
+        Quadrature weight times the surface's measure: the surface Jacobian
+        |J|, times 2πr on an axisymmetric surface; shape (cells, points).
     points
         Physical quadrature points, shape (cells, points, gdim).
+    geometric_weights
+        Quadrature weight times |J| alone (the facets' own size, for
+        geometric decisions); None when it equals ``weights``.
     """
 
     phi: npt.NDArray[np.float64]
     weights: npt.NDArray[np.float64]
     points: npt.NDArray[np.float64]
+    geometric_weights: Optional[npt.NDArray[np.float64]] = None
+
+    @property
+    def ds_weights(self) -> npt.NDArray[np.float64]:
+        """Quadrature weight times |J|: the facets' length or area element."""
+        return self.weights if self.geometric_weights is None else self.geometric_weights
 
     def values_of(self, f) -> npt.NDArray[np.float64]:
         """Evaluate a callable ``f(x)`` at the quadrature points.

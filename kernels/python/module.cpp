@@ -298,13 +298,14 @@ PYBIND11_MODULE(_kernels, m)
        const array_t& weights,
        bool opposing_normals_only,
        double length_scale,
-       bool keep_points)
+       bool keep_points,
+       bool axisymmetric)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
-      SegmentationOptions options{ opposing_normals_only,
-                                   length_scale,
-                                   keep_points };
+      SegmentationOptions options{
+        opposing_normals_only, length_scale, keep_points, axisymmetric
+      };
       MortarIntegrals r;
       {
         py::gil_scoped_release release;
@@ -358,5 +359,6 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("opposing_normals_only") = true,
     py::arg("length_scale") = 0.0,
     py::arg("keep_points") = false,
+    py::arg("axisymmetric") = false,
     "Segmentation and slave-basis mortar integrals per cell pair");
 }

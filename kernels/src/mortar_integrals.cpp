@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 
@@ -207,6 +208,10 @@ mortar_integrals(const FacetSurface& slave,
   master.check();
   if (slave.gdim != master.gdim)
     throw std::invalid_argument("slave and master surfaces differ in gdim");
+  if (options.axisymmetric and slave.gdim != 2)
+    throw std::invalid_argument(
+      "axisymmetric integrals need 2D (r, z) surfaces, got gdim " +
+      std::to_string(slave.gdim));
   if (slave_normals.size() != slave.x.size())
     throw std::invalid_argument("slave normals must have shape (nodes, gdim)");
   if (candidates.size() % 2 != 0)
@@ -378,13 +383,18 @@ mortar_integrals(const FacetSurface& slave,
             const bool n_defined = n_norm > geometric_tolerance;
             const Point3 gap_vector = sub(xs, xm);
             const double d = n_defined ? dot(gap_vector, n) / n_norm : 0.0;
-            acc.add(weights[q] * cell.measure, Ns, Nm, d);
+            // the surface of revolution's measure 2πr ds: r is the slave
+            // point's radius (clamped: a node on the axis may sit at −1e-17)
+            const double w
+              = weights[q] * cell.measure
+                * (options.axisymmetric ? 2 * std::numbers::pi * std::max(xs[0], 0.0) : 1.0);
+            acc.add(w, Ns, Nm, d);
             if (options.keep_points)
             {
               // the pair index is the number of pairs stored so far
               out.point_pairs.push_back(
                 static_cast<std::int32_t>(out.area.size()));
-              out.point_weights.push_back(weights[q] * cell.measure);
+              out.point_weights.push_back(w);
               out.point_gap.push_back(d);
               for (int k = 0; k < gdim; ++k)
                 out.point_normals.push_back(n_defined ? n[k] / n_norm : 0.0);

@@ -1,5 +1,6 @@
 """The identities of DESIGN.md §2 for every kind on B-spline, NURBS and Lagrange
-slave surfaces.
+slave surfaces, and on axisymmetric (r, z) lines, where every integral carries
+2πr (docs/AXISYMMETRIC.md): the identities hold for the weighted measure.
 
 Integrals are taken with the basis's own quadrature rule, so the discrete
 identities hold to round-off (a quadrature error would not hide a wrong basis:
@@ -53,6 +54,8 @@ SURFACES = {
             0.2 * np.random.default_rng(5).uniform(size=(4, 5))], axis=-1)),
     "P1-line": lambda: curved_line(1),
     "P2-line": lambda: curved_line(2),
+    "P1-line-axisymmetric": lambda: curved_line(1, axisymmetric=True),
+    "P2-line-axisymmetric": lambda: curved_line(2, axisymmetric=True),
     "P1-triangle": lambda: curved_patch("triangle", 1),
     "P2-triangle-transformed": lambda: curved_patch("triangle", 2, quadratic_transform=True),
     "Q1-quad": lambda: curved_patch("quadrilateral", 1),
@@ -210,3 +213,23 @@ def test_transformed_quadratic_basis_has_positive_integrals(cell, serendipity, v
     plain = ReferenceLagrange(cell, 2, serendipity=serendipity)
     N0, _ = plain.tabulate(X)
     assert np.max(wq @ N0[:, :nv]) <= 1e-15  # why the transform is needed
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+def test_axisymmetric_weights_are_the_swept_areas(degree):
+    """A flat meridian r ∈ [0, 1] sweeps the unit disk: Σ W_A = π; the node on
+    the axis carries the small ring of its first element, 2π h²/6 (P1)."""
+    from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+    from dolfinx_mortar.surfaces.structured import line_chain
+    n = 8
+    s, cells = line_chain(np.linspace(0.0, 1.0, n + 1), degree)
+    flat = LagrangeSurface("interval", degree, np.column_stack([s, np.zeros_like(s)]), cells,
+                           axisymmetric=True)
+    W = MortarBasis("LmLS*", flat).lumped_weights
+    assert abs(W.sum() - np.pi) < TOL
+    if degree == 1:
+        h = 1.0 / n
+        axis = int(np.argmin(s))
+        assert abs(W[axis] - 2 * np.pi * h ** 2 / 6) < TOL
+        # the plane measure would give h/2: the weight is really 2πr ds
+        assert abs(W[axis] - h / 2) > 0.1 * h

@@ -7,13 +7,15 @@ from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.surfaces.structured import compact_nodes, lattice_cells, line_chain
 
 
-def curved_line(degree: int, n: int = 7, seed: int = 0) -> LagrangeSurface:
-    """A wavy, non-uniform chain of P1/P2 line elements in 2D."""
+def curved_line(degree: int, n: int = 7, seed: int = 0,
+                axisymmetric: bool = False) -> LagrangeSurface:
+    """A wavy, non-uniform chain of P1/P2 line elements in 2D, from x = 0 to 1
+    (axisymmetric: a meridian in the (r, z) plane starting on the axis)."""
     rng = np.random.default_rng(seed)
     breaks = np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0.05, 0.95, n - 1)]))
     s, cells = line_chain(breaks, degree)
     x = np.column_stack([s, 0.1 * np.sin(3.0 * s)])
-    return LagrangeSurface("interval", degree, x, cells)
+    return LagrangeSurface("interval", degree, x, cells, axisymmetric=axisymmetric)
 
 
 def curved_patch(cell: str, degree: int, n: int = 4, serendipity: bool = False,

@@ -51,6 +51,9 @@ struct SegmentationOptions
   double length_scale = 0;
   /// Also return the data of every quadrature point (MortarIntegrals::point_*).
   bool keep_points = false;
+  /// Axisymmetric (2D only, coordinates (r, z)): integrate over the surface
+  /// of revolution, dμ = 2π r ds with r the slave point's first coordinate.
+  bool axisymmetric = false;
 };
 
 /// Segment candidate slave–master cell pairs and integrate on the segments.

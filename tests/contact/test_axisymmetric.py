@@ -1,0 +1,158 @@
+"""Contact in (r, z) axisymmetry: every contact integral carries 2πr.
+
+The scenes are the plane-strain ones read as meridians of bodies of
+revolution (x the radius r, y the axis z): the patch-test blocks become two
+stacked cylinders of radius 1, the pressed block a cylinder on a rigid plane
+or against a rigid sphere centred on the axis. Under a uniform pressure p on
+the top, the exact axisymmetric solution is σ_zz = −p, σ_rr = σ_θθ = 0:
+u_r = ν p r / E, u_z linear in z, and the penalty's penetration p/ε.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from dolfinx import fem, mesh
+from mpi4py import MPI
+
+from dolfinx_mortar import KIND_NAMES, ContactProblem, ContactTerm, RigidPlane, RigidSphere
+from support import load_demo
+from support.jacobian_check import jacobian_error
+from support.meshes import rectangle
+from support.scenes import block_on_plane
+
+E, NU, P = 1.0, 0.3, 0.01
+BOTTOM, TOP, AXIS = 1, 2, 3
+
+
+def two_cylinders(orientation: str):
+    """The patch-test mesh: lower and upper cylinder, non-matching at z = 0."""
+    demo = load_demo("patch_test")
+    fine, coarse = 0.09, 0.14
+    h_lower, h_upper = (fine, coarse) if orientation == "finer-slave" else (coarse, fine)
+    domain, tags = demo.build_mesh(2, h_lower, h_upper, 1, MPI.COMM_WORLD)
+    return demo, fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags, fine
+
+
+def deviation_from(problem, p: float) -> float:
+    """The largest |p_A/p − 1| over the slave nodes of all ranks."""
+    pressures = problem.nodal_pressures()
+    n = problem.slave.layout.num_owned
+    on = np.zeros(problem.slave.layout.size_local, dtype=bool)
+    on[problem.slave.cells] = True
+    local = np.max(np.abs(pressures[:n][on[:n]] / p - 1), initial=0.0)
+    return problem.mesh.comm.allreduce(float(local), op=MPI.MAX)
+
+
+@pytest.mark.parametrize("orientation", ["finer-slave", "finer-master"])
+@pytest.mark.parametrize("active_set", ["nodal", "pointwise"])
+@pytest.mark.parametrize("kind", KIND_NAMES)
+def test_patch_test_of_two_cylinders_transmits_the_uniform_pressure(kind, active_set,
+                                                                    orientation):
+    demo, V, tags, fine = two_cylinders(orientation)
+    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=E, nu=NU,
+                             kind=kind, penalty=1e3 / fine, active_set=active_set,
+                             fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
+                             tractions={demo.TOP: [0.0, -P]}, axisymmetric=True)
+    problem.solve(load_steps=1)
+    assert deviation_from(problem, P) < 1e-8
+    # the whole circular face carries p π R²; the support below pushes back as much
+    assert problem.contact_force()[1] == pytest.approx(-P * np.pi, rel=1e-8)
+    assert problem.normal_force() == pytest.approx(P * np.pi, rel=1e-8)
+    assert problem.reaction_force(demo.BOTTOM)[1] == pytest.approx(P * np.pi, rel=1e-8)
+
+
+@pytest.mark.parametrize("kind", KIND_NAMES)
+def test_seed_scaling_carries_the_load_but_not_the_uniform_pressure(kind):
+    """The seed scaling (ε on the integrated gap) is not the patch-test-passing
+    one, as in plane strain; the load still goes through."""
+    demo, V, tags, fine = two_cylinders("finer-slave")
+    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=E, nu=NU,
+                             kind=kind, penalty=1e3 / fine, scaling="seed",
+                             fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
+                             tractions={demo.TOP: [0.0, -P]}, axisymmetric=True)
+    problem.solve(load_steps=1)
+    assert problem.reaction_force(demo.BOTTOM)[1] == pytest.approx(P * np.pi, rel=1e-8)
+
+
+@pytest.mark.parametrize("kind", KIND_NAMES)
+def test_cylinder_on_a_rigid_plane_has_the_exact_axisymmetric_solution(kind):
+    V, tags = block_on_plane(n=(10, 4))
+    penalty = 1e3
+    problem = ContactProblem(V, tags, BOTTOM, obstacle=RigidPlane([0, 0], [0, 1]), E=E, nu=NU,
+                             kind=kind, penalty=penalty, fixed={AXIS: {0: 0.0}},
+                             tractions={TOP: [0.0, -P]}, axisymmetric=True)
+    problem.solve(load_steps=2)
+    assert deviation_from(problem, P) < 1e-8
+    # u_r = ν p r / E (the hoop strain), u_z = −p/ε − p z / E
+    x = V.tabulate_dof_coordinates()
+    exact = np.column_stack([NU * P * x[:, 0] / E, -P / penalty - P * x[:, 1] / E])
+    owned = V.dofmap.index_map.size_local
+    error = np.max(np.abs(problem.u.x.array.reshape(-1, 2)[:owned] - exact[:owned]))
+    assert problem.mesh.comm.allreduce(float(error), op=MPI.MAX) < 1e-8 * np.max(np.abs(exact))
+    assert problem.contact_force()[1] == pytest.approx(P * np.pi, rel=1e-8)
+
+
+@pytest.mark.parametrize("kind", ["LmLS", "LcLS*"])
+@pytest.mark.parametrize("obstacle", ["plane", "sphere"])
+def test_jacobian_matches_finite_differences_against_an_obstacle(kind, obstacle):
+    """A sphere centred on the axis: the gap's curvature and the 2πr weight."""
+    V, tags = block_on_plane(n=(6, 3))
+    ob = (RigidPlane([0, -0.0005], [0, 1]) if obstacle == "plane"   # contact for r < 0.71
+          else RigidSphere([0.0, -2.0], 2.01))
+    problem = ContactProblem(V, tags, BOTTOM, obstacle=ob, E=E, nu=NU, kind=kind, penalty=50.0,
+                             fixed={AXIS: {0: 0.0}}, tractions={TOP: [0.0, -P]},
+                             axisymmetric=True)
+    problem.set_load(1.0)
+    problem.u.interpolate(lambda x: np.vstack([0.001 * x[0] * x[1],
+                                               -0.002 + 0.003 * x[0] ** 2]))
+    fem.petsc.set_bc(problem.u.vector, problem.bcs)
+    problem.u.x.scatter_forward()
+    gaps = problem.nodal_gaps()
+    n = problem.slave.layout.num_owned
+    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) > 0
+    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] < 0))) > 0
+    assert jacobian_error(problem) < 1e-7
+
+
+@pytest.mark.parametrize("kind", ["LmLS*", "LcLS"])
+def test_jacobian_matches_finite_differences_between_two_bodies(kind):
+    demo, V, tags, fine = two_cylinders("finer-slave")
+    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=E, nu=NU,
+                             kind=kind, penalty=1e2, active_set="pointwise"
+                             if kind == "LmLS*" else "nodal",
+                             fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
+                             tractions={demo.TOP: [0.0, -P]}, axisymmetric=True)
+    problem.set_load(1.0)
+    # tilt the upper body alone (its nodes at z = 0 are its own): contact for r > ½
+    domain = problem.mesh
+    cells = np.arange(domain.topology.index_map(2).size_local, dtype=np.int32)
+    upper = cells[mesh.compute_midpoints(domain, 2, cells)[:, 1] > 0]
+    problem.u.interpolate(lambda x: np.vstack([0.002 * x[0], 0.004 * (0.5 - x[0]) + 0.0013]),
+                          cells=upper)
+    fem.petsc.set_bc(problem.u.vector, problem.bcs)
+    problem.u.x.scatter_forward()
+    gaps = problem.nodal_gaps()
+    n = problem.slave.layout.num_owned
+    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) > 0
+    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] < 0))) > 0
+    assert jacobian_error(problem) < 1e-7
+
+
+def test_bad_axisymmetric_input_is_named():
+    V, tags = block_on_plane(n=(4, 2))
+    u = fem.Function(V)
+    plane = RigidPlane([0, 0], [0, 1])
+    with pytest.raises(NotImplementedError, match="axisymmetric"):
+        ContactTerm(u, tags, BOTTOM, obstacle=plane, penalty=1.0, axisymmetric=True,
+                    basis_configuration="current")
+    # the mesh on the wrong side of the axis
+    domain, tags_left = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (4, 2), bottom=1, top=2, left=3)
+    domain.geometry.x[:, 0] -= 0.5
+    V_left = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    with pytest.raises(ValueError, match="r ≥ 0"):
+        ContactTerm(fem.Function(V_left), tags_left, BOTTOM, obstacle=plane, penalty=1.0,
+                    axisymmetric=True)
+    # a slave facet lying on the axis sweeps nothing
+    with pytest.raises(ValueError, match="on the axis"):
+        ContactTerm(u, tags, AXIS, obstacle=RigidPlane([-1, 0], [-1, 0]), penalty=1.0,
+                    axisymmetric=True)
