@@ -88,7 +88,7 @@ class ContactTerm(ContactResults):
     axisymmetric
         The mesh is the (r, z) half-plane r ≥ 0 of a body of revolution (x the
         radius, y the axis): every contact integral carries 2πr, so that
-        forces are those on the whole body (DESIGN.md §7). The user's bulk form
+        forces are those on the whole body (docs/AXISYMMETRIC.md). The user's bulk form
         must be axisymmetric too
         (:func:`~dolfinx_mortar.solver.elastic.axisymmetric_elastic_residual`).
     """

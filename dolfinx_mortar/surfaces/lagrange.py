@@ -173,7 +173,7 @@ class LagrangeSurface:
     axisymmetric
         Lines in the (r, z) half-plane r ≥ 0 standing for the surfaces they
         sweep about the axis r = 0: every integral is taken with the measure
-        2πr ds (DESIGN.md §7).
+        2πr ds (docs/AXISYMMETRIC.md).
     """
 
     def __init__(self, cell: str, degree: int, x: npt.ArrayLike, cells: npt.ArrayLike,

@@ -267,3 +267,24 @@ def test_transfer_rhs_uses_petsc_vectors():
     slave, master = pair("P1-line", "finer-slave", FULL)
     op = MortarCoupling(slave, master).operators("LcLS*")
     assert isinstance(op.transfer(op.M.createVecRight()), PETSc.Vec)
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+def test_axisymmetric_integrals_carry_the_circumference(degree):
+    """Non-matching flat meridians r ∈ [0, 1] overlapping by g: every mortar
+    integral is taken over the swept disk, so Σ D = Σ M = π (∫ 2πr dr) and the
+    gap integral is g π; the plane measure would give 1 and g."""
+    from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+
+    def axisymmetric(surface):
+        return LagrangeSurface("interval", degree, surface.x, surface.cells,
+                               axisymmetric=True)
+    g = 0.01   # the master's body (normal −y) reaches down to y = −g, into the slave's
+    slave = axisymmetric(flat_line(degree, 7, jitter=0.3, seed=2))
+    master = axisymmetric(flat_line(degree, 5, y=-g, up=False, jitter=0.3, seed=3))
+    coupling = MortarCoupling(slave, master)
+    D, M, gap = coupling.raw_pairs
+    assert abs(D.sum() - np.pi) < 1e-12 and abs(M.sum() - np.pi) < 1e-12
+    assert abs(gap.sum() - g * np.pi) < 1e-12
+    with pytest.raises(ValueError, match="both be axisymmetric"):
+        MortarCoupling(slave, flat_line(degree, 5, y=-g, up=False))
