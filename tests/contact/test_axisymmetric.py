@@ -156,3 +156,29 @@ def test_bad_axisymmetric_input_is_named():
     with pytest.raises(ValueError, match="on the axis"):
         ContactTerm(u, tags, AXIS, obstacle=RigidPlane([-1, 0], [-1, 0]), penalty=1.0,
                     axisymmetric=True)
+
+
+def test_separated_bodies_feel_no_contact_force():
+    """Before contact there is no contact force at all, not even near the axis
+    (MOOSE's RZ mortar showed spurious stresses there, idaholab/moose#28980)."""
+    demo, V, tags, fine = two_cylinders("finer-master")
+    u = fem.Function(V)
+    domain = V.mesh
+    cells = np.arange(domain.topology.index_map(2).size_local, dtype=np.int32)
+    upper = cells[mesh.compute_midpoints(domain, 2, cells)[:, 1] > 0]
+    u.interpolate(lambda x: np.vstack([0.01 * x[0], np.full(x.shape[1], 1e-4)]), cells=upper)
+    u.x.scatter_forward()
+    contact = ContactTerm(u, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, kind="LcLS*",
+                          penalty=1e3 / fine, axisymmetric=True)
+    n = contact.slave.layout.num_owned
+    gaps = contact.nodal_gaps()
+    on = np.zeros(contact.slave.layout.size_local, dtype=bool)
+    on[contact.slave.cells] = True
+    assert domain.comm.allreduce(float(np.max(gaps[:n][on[:n]], initial=-np.inf)),
+                                 op=MPI.MAX) < 0
+    # against the force a penetration as deep as the gap would give on the whole face
+    scale = 1e3 / fine * 1e-4 * np.pi
+    assert np.max(np.abs(contact.contact_force())) <= 1e-12 * scale
+    pressures = contact.nodal_pressures()[:n]
+    assert domain.comm.allreduce(float(np.max(np.abs(pressures), initial=0.0)),
+                                 op=MPI.MAX) <= 1e-12 * 1e3 / fine * 1e-4
