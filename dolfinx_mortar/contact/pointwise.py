@@ -87,7 +87,9 @@ def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: Fl
     N, dN = reference.tabulate(X, transformed=False)
     coords = slave.x[cells[c]]
     tangents = [np.einsum("nb,nbk->nk", dN[:, t, :], coords) for t in range(slave.tdim)]
-    w = w_ref * measure_from_tangents(tangents)
+    # the surface's own measure, as its tabulation's weights (2πr ds if axisymmetric)
+    w = (w_ref * measure_from_tangents(tangents)
+         * slave.radial_factor(np.einsum("nb,nbk->nk", N, coords)))
     x = np.einsum("nb,nbk->nk", N, x_nodes[cells[c]])
     dq = -model.obstacle.signed_distance(x)
     # the rule covers {d > 0} up to the bisection tolerance: clip the rest
