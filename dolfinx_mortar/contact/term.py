@@ -78,7 +78,8 @@ class ContactTerm(ContactResults):
         ``"current"``: on the current surfaces at every evaluation, with the
         exact linearization (local kinds).
     quadratic_transform
-        Transformed basis on quadratic triangle facets.
+        Transformed basis on quadratic triangle facets (always on axisymmetric
+        P2 lines, see ``axisymmetric``).
     boundary_modification
         Elastic master, dual kinds: the basis rebuilt over the covered part of
         partly covered slave facets (Popp et al. 2013).

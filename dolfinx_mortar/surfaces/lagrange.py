@@ -45,7 +45,8 @@ _REFLECTIONS = {("interval", 1, False): [1, 0],
 #: α of the transformed quadratic basis (Popp, Gitterle, Gee, Wall 2010;
 #: Wohlmuth, Popp, Gee, Wall 2012): Ñ_v = N_v + α Σ_{edges e ∋ v} N_e,
 #: Ñ_e = (1 - 2α) N_e. With α = 1/5 every Ñ has a positive integral on
-#: 6-node triangles (2A/15, A/5) and 8-node quads (A/20, A/5).
+#: 6-node triangles (2A/15, A/5), 8-node quads (A/20, A/5) and axisymmetric
+#: P2 lines with a vertex on the axis (2πh²/15 there).
 QUADRATIC_TRANSFORM_ALPHA = 0.2
 
 
@@ -118,9 +119,8 @@ class ReferenceLagrange:
         return np.vstack([vertices, mids])
 
     def _quadratic_transform(self) -> FloatArray:
-        if self.degree != 2 or self.cell == "interval":
-            raise ValueError("the transformed quadratic basis applies to quadratic "
-                             "triangles and quadrilaterals only")
+        if self.degree != 2:
+            raise ValueError("the transformed quadratic basis applies to quadratic facets only")
         if self.cell == "quadrilateral" and not self.serendipity:
             raise ValueError("9-node quadrilaterals need no transformed basis: all "
                              "their ∫N_A are positive")
@@ -173,13 +173,17 @@ class LagrangeSurface:
     axisymmetric
         Lines in the (r, z) half-plane r ≥ 0 standing for the surfaces they
         sweep about the axis r = 0: every integral is taken with the measure
-        2πr ds (docs/AXISYMMETRIC.md).
+        2πr ds (docs/AXISYMMETRIC.md). P2 lines then always use the transformed
+        quadratic basis: a P2 vertex on the axis has ∫N 2πr ds = 0 (exactly, on
+        a straight facet), which leaves the lumped and dual kinds undefined;
+        transformed, it is 2πh²/15 > 0.
     """
 
     def __init__(self, cell: str, degree: int, x: npt.ArrayLike, cells: npt.ArrayLike,
                  layout: Optional[NodeLayout] = None, serendipity: bool = False,
                  quadratic_transform: bool = False, check_cells: bool = True,
                  axisymmetric: bool = False):
+        quadratic_transform = quadratic_transform or (axisymmetric and degree == 2)
         self.reference = ReferenceLagrange(cell, degree, serendipity, quadratic_transform)
         self.x = np.asarray(x, dtype=np.float64)
         self.cells = np.asarray(cells, dtype=np.int64)

@@ -136,3 +136,12 @@ def test_hertz_axisymmetric_same_figures_on_one_and_all_ranks(obstacle):
         assert mine[key] == pytest.approx(serial[key], rel=1e-8), key
     # coarse, and for two spheres a finite lower body: within 1.5% of Hertz
     assert abs(mine["p0_error"]) < 1.5e-2 and abs(mine["a_error"]) < 1.5e-2
+
+
+@pytest.mark.slow
+def test_hertz_axisymmetric_quadratic_elements_with_a_vertex_on_the_axis():
+    """P2 (40k dofs, 17 s): measured p0 −0.30%, a +0.01%. Before the axis
+    vertex got the transformed basis its weight was a near-zero ∫N 2πr ds of a
+    curved facet and p0 came out +13.8%."""
+    figures = load_demo("hertz_axisymmetric").main(["--degree", "2", "--refine", "0.5"])
+    assert abs(figures["p0_error"]) < 5e-3 and abs(figures["a_error"]) < 5e-3
