@@ -16,7 +16,7 @@ from mpi4py import MPI
 
 from dolfinx_mortar import KIND_NAMES, ContactProblem, ContactTerm, RigidPlane, RigidSphere
 from support import load_demo
-from support.jacobian_check import jacobian_error
+from support.jacobian_check import jacobian_error, newton_step_error
 from support.meshes import rectangle
 from support.scenes import block_on_plane
 
@@ -126,6 +126,28 @@ def test_jacobian_matches_finite_differences_against_an_obstacle(kind, obstacle)
     assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) > 0
     assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] < 0))) > 0
     assert jacobian_error(problem) < 1e-7
+
+
+@pytest.mark.parametrize("active_set", ["nodal", "pointwise"])
+@pytest.mark.parametrize("kind", ["GLS", "GLS*"])
+def test_gls_newton_step_inverts_the_residual_derivative(kind, active_set):
+    """GLS kinds: the augmented step against R' by differences; the sphere cuts
+    slave cells (pointwise: the split cells' rule with 2πr)."""
+    V, tags = block_on_plane(n=(6, 3))
+    problem = ContactProblem(V, tags, BOTTOM, obstacle=RigidSphere([0.0, -2.0], 2.0), E=E,
+                             nu=NU, kind=kind, penalty=50.0, fixed={AXIS: {0: 0.0}},
+                             tractions={TOP: [0.0, -P]}, active_set=active_set,
+                             axisymmetric=True)
+    problem.set_load(1.0)
+    problem.u.interpolate(lambda x: np.vstack([0.001 * x[0] * x[1],
+                                               -0.0031 + 0.003 * x[0] ** 2]))
+    fem.petsc.set_bc(problem.u.vector, problem.bcs)
+    problem.u.x.scatter_forward()
+    gaps = problem.nodal_gaps()
+    n = problem.slave.layout.num_owned
+    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) > 0
+    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] < 0))) > 0
+    assert newton_step_error(problem) < 1e-6
 
 
 @pytest.mark.parametrize("kind", ["LmLS*", "LcLS"])

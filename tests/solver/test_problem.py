@@ -11,7 +11,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactDivergenceError, ContactProblem
-from support.jacobian_check import residual_difference
+from support.jacobian_check import newton_step_error
 from support import load_demo
 from support.scenes import (ALL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks,
                             block_on_plane, pressed_block)
@@ -367,27 +367,11 @@ def test_gls_newton_step_inverts_the_residual_derivative(kind, active_set):
                              tractions={2: [0.0, -0.01]}, active_set=active_set)
     problem.set_load(1.0)
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[1], -0.0031 + 0.003 * x[0] ** 2]))
-    x0 = problem.u.vector.copy()
-    b0 = problem.problem.vector().duplicate()
-    problem.problem.F(x0, b0)
-    J = problem.problem.matrix()
-    problem.problem.J(x0, J)
     gaps = problem.nodal_gaps()
     n = problem.slave.layout.num_owned
     assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) > 0
     assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] < 0))) > 0
-    r = b0.duplicate()
-    r.array[:] = np.random.default_rng(2 + MPI.COMM_WORLD.rank).normal(size=r.array.shape)
-    fem.petsc.set_bc(r, problem.bcs, scale=0.0)
-    du = r.duplicate()
-    ksp = PETSc.KSP().create(problem.mesh.comm)
-    ksp.setOperators(J)
-    problem.problem.configure_ksp(ksp)    # the exact step of the augmented system
-    ksp.solve(r, du)
-    fd = residual_difference(problem, x0, du)
-    fd.axpy(-1.0, r)
-    assert fd.norm() < 1e-6 * r.norm()
-    ksp.destroy()
+    assert newton_step_error(problem) < 1e-6
 
 
 def test_previous_configuration_resegments_and_still_passes_the_patch_test():

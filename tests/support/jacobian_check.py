@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 
@@ -28,6 +29,30 @@ def jacobian_error(problem, rng_seed: int = 1) -> float:
     fd = residual_difference(problem, x0, dx)
     fd.axpy(-1.0, Jdx)
     return fd.norm() / Jdx.norm()
+
+
+def newton_step_error(problem, rng_seed: int = 2) -> float:
+    """‖R'(x)Δu − r‖/‖r‖ for the Newton step Δu the problem's own linear solve
+    gives for a random r (the augmented system of the GLS kinds), R' by
+    central differences, at the current u."""
+    x0 = problem.u.vector.copy()
+    b0 = problem.problem.vector().duplicate()
+    problem.problem.F(x0, b0)
+    J = problem.problem.matrix()
+    problem.problem.J(x0, J)
+    r = b0.duplicate()
+    r.array[:] = np.random.default_rng(rng_seed + MPI.COMM_WORLD.rank).normal(
+        size=r.array.shape)
+    fem.petsc.set_bc(r, problem.bcs, scale=0.0)
+    du = r.duplicate()
+    ksp = PETSc.KSP().create(problem.mesh.comm)
+    ksp.setOperators(J)
+    problem.problem.configure_ksp(ksp)    # the exact step of the augmented system
+    ksp.solve(r, du)
+    ksp.destroy()
+    fd = residual_difference(problem, x0, du)
+    fd.axpy(-1.0, r)
+    return fd.norm() / r.norm()
 
 
 def residual_difference(problem, x0, direction, size: float = 1e-6):
