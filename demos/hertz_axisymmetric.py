@@ -31,7 +31,6 @@ from dolfinx_mortar.demo_support.cli import (add_contact_options, parse_args_and
 from dolfinx_mortar.demo_support.hertz_meshes import (FIXED, LOAD, MASTER, SLAVE, SYMMETRY,
                                                       quarter_disk_mesh)
 from dolfinx_mortar.io.output import write_json
-from dolfinx_mortar.kinds import DUAL_KINDS, parse_kind
 
 LOWER_BODY = {"rigid": "none", "elastic": "block", "sphere": "disk"}
 
@@ -119,17 +118,11 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
         kwargs["master_tag"] = MASTER
         fixed[FIXED] = {0: 0.0, 1: 0.0}
     traction = [0.0, -args.force / (np.pi * args.radius ** 2)]
-    # Two spheres part slowly: where the search radius ends, a slave facet is
-    # covered by the lower sphere near one node only, and the dual functions,
-    # negative there, turn the gap into a false penetration. The boundary
-    # modification rebuilds them over the covered part.
-    modified = args.boundary_modification or (args.obstacle == "sphere"
-                                              and parse_kind(args.kind) in DUAL_KINDS)
     problem = ContactProblem(V, facet_tags, SLAVE, E=args.E, nu=args.nu, kind=args.kind,
                              penalty=args.penalty * args.E / h_contact,
                              active_set=args.active_set,
                              basis_configuration=args.basis_configuration,
-                             boundary_modification=modified,
+                             boundary_modification=args.boundary_modification,
                              fixed=fixed, tractions={LOAD: traction}, axisymmetric=True,
                              **kwargs)
     return problem, ref, h_contact

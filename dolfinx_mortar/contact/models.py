@@ -46,7 +46,7 @@ class ContactOptions:
 
     @classmethod
     def checked(cls, kind: KindLike, penalty: float, scaling: str, active_set: str,
-                basis_configuration: str, boundary_modification: bool,
+                basis_configuration: str, boundary_modification: Optional[bool],
                 search_radius: Optional[float], elastic_master: bool,
                 axisymmetric: bool = False) -> "ContactOptions":
         gap_kind(kind, scaling)  # names an unknown kind or scaling
@@ -59,6 +59,13 @@ class ContactOptions:
         if basis_configuration not in CONFIGURATIONS:
             raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
                              f"expected {CONFIGURATIONS}")
+        if boundary_modification is None:
+            # the dual functions are negative near a facet's far node: a facet the
+            # master covers only there reads a separation as a penetration. The
+            # modification is the cure wherever it is implemented.
+            boundary_modification = (elastic_master and kind in DUAL_KINDS
+                                     and basis_configuration != "current"
+                                     and active_set == "nodal")
         if basis_configuration == "current" and boundary_modification:
             raise NotImplementedError("basis_configuration='current' with the boundary "
                                       "modification is not implemented")

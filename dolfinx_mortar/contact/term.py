@@ -82,7 +82,12 @@ class ContactTerm(ContactResults):
         P2 lines, see ``axisymmetric``).
     boundary_modification
         Elastic master, dual kinds: the basis rebuilt over the covered part of
-        partly covered slave facets (Popp et al. 2013).
+        partly covered slave facets (Popp et al. 2013). ``None`` (default):
+        on for the dual kinds against an elastic master with the nodal active
+        set in the "initial" and "previous" configurations, where it is
+        implemented. Without it, a slave facet that the master covers only
+        near its far node reads a separation as a penetration (the dual
+        functions are negative there).
     search_radius
         How far apart slave and master facets may be and still be paired
         (default the largest slave facet diameter).
@@ -98,7 +103,8 @@ class ContactTerm(ContactResults):
                  master_tag: Optional[int] = None, obstacle: Optional[RigidObstacle] = None,
                  kind: KindLike = "LcLS*", penalty: float, scaling: str = "consistent",
                  active_set: str = "nodal", basis_configuration: str = "initial",
-                 quadratic_transform: bool = False, boundary_modification: bool = False,
+                 quadratic_transform: bool = False,
+                 boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, axisymmetric: bool = False):
         if not isinstance(u, fem.Function):
             raise TypeError(f"u must be a dolfinx.fem.Function (the displacement), got "

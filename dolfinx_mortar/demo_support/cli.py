@@ -40,9 +40,11 @@ def add_contact_options(parser: argparse.ArgumentParser) -> None:
     """The solver options every contact demo offers (see ContactProblem)."""
     parser.add_argument("--active-set", default="nodal", choices=("nodal", "pointwise"),
                         help="penalty on the nodal gaps (nodal) or on ⟨d⟩ (pointwise)")
-    parser.add_argument("--boundary-modification", action="store_true",
+    parser.add_argument("--boundary-modification", action=argparse.BooleanOptionalAction,
+                        default=None,
                         help="dual kinds on an elastic master: basis over the covered part "
-                             "of partly covered facets")
+                             "of partly covered facets (default: the library's, on for dual "
+                             "kinds against an elastic master, nodal set, initial/previous)")
     parser.add_argument("--basis-configuration", default="initial",
                         choices=("initial", "previous", "current"),
                         help="configuration of the bases: initial, previous step, current")

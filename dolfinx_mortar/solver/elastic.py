@@ -77,7 +77,8 @@ class ContactProblem:
                  scaling: str = "consistent", active_set: str = "nodal",
                  basis_configuration: str = "initial",
                  fixed: Optional[dict] = None, tractions: Optional[dict] = None,
-                 quadratic_transform: bool = False, boundary_modification: bool = False,
+                 quadratic_transform: bool = False,
+                 boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, petsc_options: Optional[dict] = None,
                  axisymmetric: bool = False):
         mesh = V.mesh
