@@ -108,3 +108,44 @@ def test_modification_is_refused_where_it_does_not_apply():
     V, tags = overhanging_blocks()
     with pytest.raises(ValueError, match="dual kinds"):
         _problem(V, tags, "LmLS*", True)
+
+
+@pytest.mark.parametrize("axisymmetric", [False, True])
+def test_two_touching_cylinders_see_no_false_penetration_by_default(axisymmetric):
+    """Two cylinders (or spheres) touching at a point part slowly: where the
+    search radius ends, a slave facet is covered by the master near its far
+    node only, and a dual function (negative there) turns the 0.03 separation
+    into a penetration. The default switches the modification on for the dual
+    kinds against an elastic master; off, the false penetration is there."""
+    from dolfinx_mortar import ContactTerm
+    from dolfinx_mortar.demo_support.hertz_meshes import MASTER, SLAVE, quarter_disk_mesh
+    from support import load_demo
+    demo = load_demo("hertz_axisymmetric")    # its two-sphere mesh at the default size
+    a = demo.hertz(demo.parse_args(["--obstacle", "sphere"]))["a"]
+    h = a / 40
+    domain, tags = quarter_disk_mesh(1.0, a, h, "disk", 1, MPI.COMM_WORLD)
+    u = fem.Function(fem.VectorFunctionSpace(domain, ("Lagrange", 1)))
+
+    def largest_gap(**options) -> float:
+        contact = ContactTerm(u, tags, SLAVE, master_tag=MASTER, kind="LcLS*", penalty=1e3,
+                              axisymmetric=axisymmetric, **options)
+        n = contact.slave.layout.num_owned
+        gaps = contact.nodal_gaps()[:n]
+        return domain.comm.allreduce(float(np.max(gaps, initial=-np.inf)), op=MPI.MAX)
+    # the bodies touch at the axis node only: no gap above round-off
+    assert largest_gap() <= 1e-12 * h
+    with pytest.warns(RuntimeWarning, match="boundary_modification=True"):
+        assert largest_gap(boundary_modification=False) > 0.5 * h
+
+
+def test_the_modification_is_on_by_default_only_where_it_applies():
+    from dolfinx_mortar import ContactTerm, RigidPlane
+    V, tags = overhanging_blocks()
+    u = fem.Function(V)
+
+    def default(**options) -> bool:
+        return ContactTerm(u, tags, 1, penalty=1e3, **options).options.boundary_modification
+    assert default(master_tag=2, kind="LcLS*") and default(master_tag=2, kind="LcLS")
+    assert not default(master_tag=2, kind="LmLS")
+    assert not default(obstacle=RigidPlane([0, -1], [0, 1]), kind="LcLS*")
+    assert not default(master_tag=2, kind="LcLS*", basis_configuration="current")
