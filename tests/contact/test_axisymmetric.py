@@ -106,26 +106,33 @@ def test_cylinder_on_a_rigid_plane_has_the_exact_axisymmetric_solution(kind):
     assert problem.contact_force()[1] == pytest.approx(P * np.pi, rel=1e-8)
 
 
-@pytest.mark.parametrize("kind", ["LmLS", "LcLS*"])
-@pytest.mark.parametrize("obstacle", ["plane", "sphere"])
-def test_jacobian_matches_finite_differences_against_an_obstacle(kind, obstacle):
-    """A sphere centred on the axis: the gap's curvature and the 2πr weight."""
+def pressed_cylinder(obstacle, kind: str, depth: float, active_set: str = "nodal"):
+    """A coarse cylinder against ``obstacle`` at full load, deformed so that its
+    bottom penetrates by ``depth`` on the axis and less outwards (the contact
+    ends inside the slave surface); returns the problem."""
     V, tags = block_on_plane(n=(6, 3))
-    ob = (RigidPlane([0, -0.0005], [0, 1]) if obstacle == "plane"   # contact for r < 0.71
-          else RigidSphere([0.0, -2.0], 2.01))
-    problem = ContactProblem(V, tags, BOTTOM, obstacle=ob, E=E, nu=NU, kind=kind, penalty=50.0,
-                             fixed={AXIS: {0: 0.0}}, tractions={TOP: [0.0, -P]},
-                             axisymmetric=True)
+    problem = ContactProblem(V, tags, BOTTOM, obstacle=obstacle, E=E, nu=NU, kind=kind,
+                             penalty=50.0, fixed={AXIS: {0: 0.0}}, tractions={TOP: [0.0, -P]},
+                             active_set=active_set, axisymmetric=True)
     problem.set_load(1.0)
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[0] * x[1],
-                                               -0.002 + 0.003 * x[0] ** 2]))
+                                               -depth + 0.003 * x[0] ** 2]))
     fem.petsc.set_bc(problem.u.vector, problem.bcs)
     problem.u.x.scatter_forward()
     gaps = problem.nodal_gaps()
     n = problem.slave.layout.num_owned
     assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) > 0
     assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] < 0))) > 0
-    assert jacobian_error(problem) < 1e-7
+    return problem
+
+
+@pytest.mark.parametrize("kind", ["LmLS", "LcLS*"])
+@pytest.mark.parametrize("obstacle", ["plane", "sphere"])
+def test_jacobian_matches_finite_differences_against_an_obstacle(kind, obstacle):
+    """A sphere centred on the axis: the gap's curvature and the 2πr weight."""
+    ob = (RigidPlane([0, -0.0005], [0, 1]) if obstacle == "plane"   # contact for r < 0.71
+          else RigidSphere([0.0, -2.0], 2.01))
+    assert jacobian_error(pressed_cylinder(ob, kind, depth=0.002)) < 1e-7
 
 
 @pytest.mark.parametrize("active_set", ["nodal", "pointwise"])
@@ -133,20 +140,8 @@ def test_jacobian_matches_finite_differences_against_an_obstacle(kind, obstacle)
 def test_gls_newton_step_inverts_the_residual_derivative(kind, active_set):
     """GLS kinds: the augmented step against R' by differences; the sphere cuts
     slave cells (pointwise: the split cells' rule with 2πr)."""
-    V, tags = block_on_plane(n=(6, 3))
-    problem = ContactProblem(V, tags, BOTTOM, obstacle=RigidSphere([0.0, -2.0], 2.0), E=E,
-                             nu=NU, kind=kind, penalty=50.0, fixed={AXIS: {0: 0.0}},
-                             tractions={TOP: [0.0, -P]}, active_set=active_set,
-                             axisymmetric=True)
-    problem.set_load(1.0)
-    problem.u.interpolate(lambda x: np.vstack([0.001 * x[0] * x[1],
-                                               -0.0031 + 0.003 * x[0] ** 2]))
-    fem.petsc.set_bc(problem.u.vector, problem.bcs)
-    problem.u.x.scatter_forward()
-    gaps = problem.nodal_gaps()
-    n = problem.slave.layout.num_owned
-    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] > 0))) > 0
-    assert problem.mesh.comm.allreduce(int(np.sum(gaps[:n] < 0))) > 0
+    problem = pressed_cylinder(RigidSphere([0.0, -2.0], 2.0), kind, depth=0.0031,
+                               active_set=active_set)
     assert newton_step_error(problem) < 1e-6
 
 

@@ -138,15 +138,22 @@ def test_dolfinx_newton_solver_drives_the_contact_problem(kind):
     assert reaction_force(problem, tags, TOP)[1] == pytest.approx(-p_exact, rel=1e-8)
 
 
-def test_load_path_moves_the_obstacle_and_takes_petsc_options(tmp_path):
-    """The user's callback moves the obstacle along the load path; petsc_options
-    reach the solver and leave the options database afterwards."""
+def block_under_a_moving_plane() -> tuple[NonlinearContactProblem, RigidPlane]:
+    """The block, its top held, over a rigid plane the load path moves up (LcLS*,
+    ε = 1e3): the problem and the plane."""
     domain, tags, V = block()
     u = fem.Function(V)
     plane = RigidPlane([0.0, 0.0], [0.0, 1.0])
     contact = ContactTerm(u, tags, BOTTOM, obstacle=plane, kind="LcLS*", penalty=1e3)
     bcs = [dirichlet(V, tags, LEFT, 0, 0.0), dirichlet(V, tags, TOP, 1, 0.0)]
-    problem = NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact, bcs)
+    return NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact, bcs), plane
+
+
+def test_load_path_moves_the_obstacle_and_takes_petsc_options(tmp_path):
+    """The user's callback moves the obstacle along the load path; petsc_options
+    reach the solver and leave the options database afterwards."""
+    problem, plane = block_under_a_moving_plane()
+    contact, u, domain = problem.contacts[0], problem.u, problem.u.function_space.mesh
     solver = LoadPathSolver(problem, petsc_options={"snes_max_it": 7}, prefix="open_path_")
     seen = []
     output = Path(domain.comm.bcast(str(tmp_path / "path.xdmf"), root=0))  # one file for all ranks
@@ -222,12 +229,8 @@ def test_linear_predictor_starts_a_linear_path_at_its_solution(predictor):
     """On a path whose solution is linear in t (the plane moved up at a constant
     rate, the contact already closed), the linear predictor lands on the
     solution of every step after the second: Newton has nothing left to do."""
-    domain, tags, V = block()
-    u = fem.Function(V)
-    plane = RigidPlane([0.0, 0.0], [0.0, 1.0])
-    contact = ContactTerm(u, tags, BOTTOM, obstacle=plane, kind="LcLS*", penalty=1e3)
-    bcs = [dirichlet(V, tags, LEFT, 0, 0.0), dirichlet(V, tags, TOP, 1, 0.0)]
-    problem = NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact, bcs)
+    problem, plane = block_under_a_moving_plane()
+    contact = problem.contacts[0]
     forces = []
     result = LoadPathSolver(problem).solve(
         lambda t: plane.move_to([0.0, 0.01 * (1 + t)]), load_steps=5, predictor=predictor,
