@@ -15,26 +15,18 @@ from __future__ import annotations
 
 import argparse
 import gc
-import importlib.util
 import os
 from pathlib import Path
 from typing import Optional, Sequence
 
 from mpi4py import MPI
 
+from dolfinx_mortar.demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import save_figure, write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent
-DEMOS = HERE.parent / "demos"
 COLUMNS = ("model", "refine", "dofs", "p0_error", "a_error", "l2_error", "newton_iterations",
            "wall_time")
-
-
-def load_demo(name: str):
-    spec = importlib.util.spec_from_file_location(name, DEMOS / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:

@@ -17,6 +17,8 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.demo_support.scripts import load_demo
+
 ALL_KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 DUAL_KINDS = ("LcLS*", "LcLS")
 
@@ -290,12 +292,7 @@ def quadratic_identities(kind: str, slave_type: str) -> dict:
 def patch_test_run(kind: str, dim: int, degree: int, fine: float, coarse: float,
                    orientation: str) -> dict:
     """The contact patch test of demos/patch_test.py (consistent scaling)."""
-    import importlib.util
-    from pathlib import Path
-    path = Path(__file__).resolve().parent.parent / "demos" / "patch_test.py"
-    spec = importlib.util.spec_from_file_location("patch_test", path)
-    demo = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(demo)
+    demo = load_demo("patch_test")
     args = demo.parse_args(["--dim", str(dim), "--degree", str(degree), "--fine", str(fine),
                             "--coarse", str(coarse)])
     r = demo.run(args, orientation, kind, "consistent")
@@ -307,15 +304,10 @@ def patch_test_run(kind: str, dim: int, degree: int, fine: float, coarse: float,
 def hertz2d_problem(kind: str, penalty_factor: float, refine: float = 0.3,
                     obstacle: str = "rigid"):
     """The hertz2d demo's scene as a ContactProblem (not yet solved)."""
-    import importlib.util
-    from pathlib import Path
     from dolfinx import fem
     from dolfinx_mortar.contact.obstacles import RigidPlane
     from dolfinx_mortar import ContactProblem
-    path = Path(__file__).resolve().parent.parent / "demos" / "hertz2d.py"
-    spec = importlib.util.spec_from_file_location("hertz2d", path)
-    demo = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(demo)
+    demo = load_demo("hertz2d")
     args = demo.parse_args(["--refine", str(refine), "--obstacle", obstacle])
     ref = demo.hertz(args)
     domain, tags, h = demo.build_mesh(args, ref["a"], MPI.COMM_WORLD)

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import gc
-import importlib.util
 import time
 import warnings
 from pathlib import Path
@@ -28,23 +27,16 @@ from typing import Optional, Sequence
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactDivergenceError
+from dolfinx_mortar.demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent
-DEMO = HERE.parent / "demos" / "press_and_slide.py"
 KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 CONFIGURATIONS = ("initial", "previous", "current")
 COLUMNS = ("kind", "configuration", "status", "tangential_oscillation", "tangential_std",
            "tangential_mean", "normal_oscillation", "normal_mean", "newton_iterations",
            "max_newton_per_step", "max_terminal_iterations", "load_steps", "requested_steps", "wall_time", "dofs", "h",
            "reason")
-
-
-def load_demo():
-    spec = importlib.util.spec_from_file_location("press_and_slide", DEMO)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
@@ -131,7 +123,7 @@ def markdown_table(rows: list[dict], args: argparse.Namespace) -> str:
 def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
     args = parse_args(argv)
     comm = MPI.COMM_WORLD
-    demo = load_demo()
+    demo = load_demo("press_and_slide")
     rows = []
     out = Path(args.out)
     for kind in args.kinds:

@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import argparse
 import gc
-import importlib.util
 import math
 import sys
 import time
@@ -50,9 +49,9 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
+from dolfinx_mortar.demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import save_figure, write_atomically, write_csv  # noqa: E402
 
-DEMOS = Path(__file__).resolve().parent.parent / "demos"
 KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 DEFAULT_LEVELS = {"2d": [0.5, 1.0, 2.0], "3d": [0.5, 1.0]}
 QUICK_LEVELS = {"2d": [0.5], "3d": [0.5]}
@@ -64,13 +63,6 @@ COLUMNS = ("scene", "obstacle", "refine", "dofs", "slave_nodes", "kind", "penalt
            "newton_iterations", *[t + "_s" for t in TIMES], "time_s", "wall_s",
            "contact_ms_per_iteration", "bulk_ms_per_iteration", "solve_ms_per_iteration",
            "contact_fraction", "p0_error", "a_error", "l2_error")
-
-
-def load_demo(name: str):
-    spec = importlib.util.spec_from_file_location(name, DEMOS / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def setup_times(problem) -> dict:
