@@ -17,6 +17,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.demo_support.hertz_fit import fit_hertz_profile
 from dolfinx_mortar.demo_support.scripts import load_demo
 
 ALL_KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
@@ -569,35 +570,6 @@ def two_cylinders_mesh(R1: float, R2: float, h_contact: float, a: float, comm: M
     return domain, tags
 
 
-def _fit_p0_a(r: np.ndarray, p: np.ndarray) -> tuple[float, float]:
-    """Peak pressure and contact size from p² linear in r² (inner 90%)."""
-    on = p > 0
-    r, p = r[on], p[on]
-    inner = r < 0.9 * np.max(r)
-    c1, c0 = np.polyfit(r[inner] ** 2, p[inner] ** 2, 1)
-    return float(np.max(p)), float(np.sqrt(-c0 / c1)) if c1 < 0 < c0 else float("nan")
-
-
-def _fit_hertz_profile(r: np.ndarray, p: np.ndarray) -> tuple[float, float]:
-    """p0 and a of the Hertz profile p0 √(1 − r²/a²) fitted (least squares in p)
-    to the nodes with p > 0.
-
-    On unstructured tetrahedra the nodal pressures scatter by up to ±30% from
-    node to node (LmLS*), so the largest one is no estimate of p0, and the fit
-    of p² against r² in :func:`_fit_p0_a` weights the scattered edge nodes
-    most and can lose the slope altogether (a +145% on the a/4 mesh).
-    """
-    from scipy.optimize import least_squares
-    on = p > 0
-    r, p = r[on], p[on]
-
-    def residual(q):
-        return q[0] * np.sqrt(np.maximum(0.0, 1 - (r / q[1]) ** 2)) - p
-
-    fit = least_squares(residual, [np.max(p), 1.05 * np.max(r)])
-    return float(fit.x[0]), float(fit.x[1])
-
-
 def two_cylinders(kind: str, R1: float = 1.0, R2: float = 2.0, force: float = 0.01,
                   refine: float = 0.5) -> dict:
     """Two elastic cylinders (plane strain, same material) against Hertz with
@@ -618,9 +590,9 @@ def two_cylinders(kind: str, R1: float = 1.0, R2: float = 2.0, force: float = 0.
     result = problem.solve(load_steps=3)
     p = slave_values(problem, problem.nodal_pressures())
     x = slave_coordinates(problem)[:, 0]
-    p0_h, a_h = _fit_p0_a(x, p)
-    return {"case": "cylinders", "kind": kind, "p0_error": p0_h / p0 - 1,
-            "a_error": a_h / a - 1, "newton": result.newton_iterations,
+    fit = fit_hertz_profile(x, p, a)
+    return {"case": "cylinders", "kind": kind, "p0_error": fit.p0 / p0 - 1,
+            "a_error": fit.a / a - 1, "newton": result.newton_iterations,
             "force_error": contact_force(problem) / (force / 2) - 1,
             "dofs": V.dofmap.index_map.size_global * 2}
 
@@ -702,10 +674,10 @@ def two_spheres(kind: str, R1: float = 1.0, R2: float = 1.0, force: float = 0.00
     result = problem.solve(load_steps=3)
     p = slave_values(problem, problem.nodal_pressures())
     r = np.linalg.norm(slave_coordinates(problem)[:, :2], axis=1)
-    p0_h, a_h = _fit_hertz_profile(r, p)
-    return {"case": "spheres", "kind": kind, "p0_error": p0_h / p0 - 1,
-            "p0_max_error": float(np.max(p)) / p0 - 1,
-            "a_error": a_h / a - 1, "newton": result.newton_iterations,
+    fit = fit_hertz_profile(r, p, a)
+    return {"case": "spheres", "kind": kind, "p0_error": fit.p0 / p0 - 1,
+            "p0_max_error": fit.p_max / p0 - 1,
+            "a_error": fit.a / a - 1, "newton": result.newton_iterations,
             "force_error": contact_force(problem) / (force / 4) - 1,
             "dofs": V.dofmap.index_map.size_global * 3,
             "wall_time": time.perf_counter() - clock}
