@@ -217,6 +217,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
                              active_set=args.active_set,
                              basis_configuration=args.basis_configuration,
                              boundary_modification=args.boundary_modification,
+                             linear_solver=args.linear_solver,
                              fixed=fixed, tractions=tractions, **kwargs)
     return problem, {"E_star": E_star, "h_contact": h_contact, "quarter": quarter}
 
@@ -231,6 +232,8 @@ def key_figures(args: argparse.Namespace, problem, result, context: dict,
     V = problem.V
     dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
     figures.update({"dofs": int(dofs), "newton_iterations": result.newton_iterations,
+                    "linear_iterations": result.linear_iterations,
+                    "linear_solver": problem.solver.linear_solver,
                     "load_steps": len(result.steps), "wall_time": wall,
                     "h_contact": context["h_contact"], "contact_force": contact_force,
                     "force": force, "kind": args.kind, "refine": args.refine,

@@ -123,6 +123,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
                              active_set=args.active_set,
                              basis_configuration=args.basis_configuration,
                              boundary_modification=args.boundary_modification,
+                             linear_solver=args.linear_solver,
                              fixed=fixed, tractions={LOAD: traction}, axisymmetric=True,
                              **kwargs)
     return problem, ref, h_contact

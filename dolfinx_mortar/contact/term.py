@@ -140,6 +140,9 @@ class ContactTerm(ContactResults):
         self._last_active: Optional[FloatArray] = None
         self._augmented: Optional[AugmentedNewtonStep] = None
         self._built_at: Optional[FloatArray] = None
+        #: global indices of this rank's rows that the last contact Jacobian
+        #: stiffened (:meth:`assemble_jacobian`)
+        self.stiffened_rows: np.ndarray = np.zeros(0, dtype=PETSc.IntType)
         self.model: GapModel = self._build(None)
         self.warn_deep_initial_penetration()
 
@@ -260,6 +263,7 @@ class ContactTerm(ContactResults):
                     and np.array_equal(active, self._last_active)), op=MPI.LAND)
                 self._last_active = active
             K = self.model.jacobian(state, active, mask, geometric=settled)
+            self.stiffened_rows = stiffened_rows(K, self.V.dofmap.index_map_bs)
             A.axpy(1.0, K, structure=SUBSET)
             A.assemble()
         self._add("jacobian", clock)
@@ -311,3 +315,24 @@ class ContactTerm(ContactResults):
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
+
+
+#: rows whose diagonal is below this fraction of the largest contact diagonal
+#: count as unstiffened: a preconditioning choice (such a row is left to
+#: multigrid), not a correctness decision
+STIFFENED_FRACTION = 1e-12
+
+
+def stiffened_rows(K: PETSc.Mat, bs: int) -> np.ndarray:
+    """Global indices of the owned rows of a contact Jacobian ``K`` with a
+    diagonal entry above :data:`STIFFENED_FRACTION` of K's largest (over all
+    ranks); whole dof blocks of size ``bs`` (nodes), so that a node's
+    directions stay together."""
+    diagonal = K.getDiagonal()
+    scale = diagonal.norm(PETSc.NormType.NORM_INFINITY)
+    values = np.abs(diagonal.array_r).reshape(-1, bs).max(axis=1)
+    start = diagonal.getOwnershipRange()[0]
+    diagonal.destroy()
+    nodes = np.flatnonzero(values > STIFFENED_FRACTION * scale)
+    return (start + bs * nodes[:, None] + np.arange(bs)).ravel().astype(PETSc.IntType)
+

@@ -45,6 +45,10 @@ def add_contact_options(parser: argparse.ArgumentParser) -> None:
                         help="dual kinds on an elastic master: basis over the covered part "
                              "of partly covered facets (default: the library's, on for dual "
                              "kinds against an elastic master, nodal set, initial/previous)")
+    parser.add_argument("--linear-solver", default="auto",
+                        choices=("auto", "direct", "iterative"),
+                        help="MUMPS, Krylov + multigrid + exact contact block, or by size "
+                             "(auto: iterative for 3D from 100k dofs)")
     parser.add_argument("--basis-configuration", default="initial",
                         choices=("initial", "previous", "current"),
                         help="configuration of the bases: initial, previous step, current")

@@ -62,8 +62,9 @@ class ContactProblem:
         load factor 1 (scaled by the load factor).
     tractions
         ``{tag: vector}``: surface tractions at load factor 1.
-    petsc_options
-        Options of the solver (:class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`).
+    petsc_options, linear_solver
+        Options and the linear solver ("auto", "direct", "iterative") of the
+        solver (:class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`).
     axisymmetric
         V lives on the (r, z) half-plane of a body of revolution: the bulk is
         :func:`~dolfinx_mortar.solver.axisymmetric.axisymmetric_elastic_residual`,
@@ -80,7 +81,7 @@ class ContactProblem:
                  quadratic_transform: bool = False,
                  boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, petsc_options: Optional[dict] = None,
-                 axisymmetric: bool = False):
+                 axisymmetric: bool = False, linear_solver: str = "auto"):
         mesh = V.mesh
         gdim = mesh.geometry.dim
         if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
@@ -125,7 +126,7 @@ class ContactProblem:
                 self._bc_values.append((c, float(value)))
                 self.bcs.append(fem.dirichletbc(c, dofs, V.sub(k)))
         self.problem = NonlinearContactProblem(F, self.u, self.contact, self.bcs)
-        self.solver = LoadPathSolver(self.problem, petsc_options)
+        self.solver = LoadPathSolver(self.problem, petsc_options, linear_solver=linear_solver)
 
     # -- the parts, for users who go further ---------------------------------------------
     @property

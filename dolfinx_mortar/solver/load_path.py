@@ -22,6 +22,9 @@ from dolfinx_mortar.input_checks import unused_petsc_options
 from dolfinx_mortar.io.contact_output import ContactOutput
 from dolfinx_mortar.solver.convergence import (ContactDivergenceError, EquilibriumTest,
                                                FailedAttempt, describe_failure)
+from dolfinx_mortar.solver.contact_block_pc import ContactBlockPreconditioner
+from dolfinx_mortar.solver.linear_solver import (DIRECT_OPTIONS, choose_linear_solver,
+                                                 iterative_options)
 from dolfinx_mortar.solver.load_stepping import LoadStepper
 from dolfinx_mortar.solver.newton_start import PathExtrapolation, close_gaps
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
@@ -43,12 +46,25 @@ class LoadPathSolver:
         after each solve.
     prefix
         The options prefix (command-line options ``-<prefix>snes_…`` apply).
+    linear_solver
+        ``"direct"`` (MUMPS), ``"iterative"`` (CG/GMRES with multigrid and an
+        exact contact block) or ``"auto"`` (iterative for large 3D problems;
+        :mod:`dolfinx_mortar.solver.linear_solver`). Options under the prefix
+        still override each choice.
     """
 
     def __init__(self, problem: NonlinearContactProblem,
-                 petsc_options: Optional[dict] = None, prefix: str = "dolfinx_mortar_"):
+                 petsc_options: Optional[dict] = None, prefix: str = "dolfinx_mortar_",
+                 linear_solver: str = "auto"):
         self.problem = problem
         self.prefix = prefix
+        augmented = any(term.augmented for term in problem.contacts)
+        gdim = problem.u.function_space.mesh.geometry.dim
+        #: "direct" or "iterative", as chosen for this problem
+        self.linear_solver = choose_linear_solver(linear_solver, problem.num_dofs, gdim,
+                                                  augmented)
+        #: the iterative path's preconditioner, once made
+        self.preconditioner: Optional[ContactBlockPreconditioner] = None
         self.petsc_options = dict(petsc_options or {})
         self.comm = problem.u.function_space.mesh.comm
         self.equilibrium = EquilibriumTest()
@@ -74,6 +90,10 @@ class LoadPathSolver:
         defaults = dict(DEFAULT_OPTIONS)
         if any(term.basis_configuration == "current" for term in self.contacts):
             defaults["snes_linesearch_type"] = "l2"
+        if self.linear_solver == "iterative":
+            for key in DIRECT_OPTIONS:
+                defaults.pop(key)
+            defaults.update(iterative_options(self.problem.symmetric))
         return defaults
 
     def options(self) -> TemporaryOptions:
@@ -96,8 +116,22 @@ class LoadPathSolver:
         snes.setConvergenceHistory()
         snes.setFromOptions()
         snes.setConvergenceTest(self.equilibrium)
+        self._configure_preconditioner(snes.getKSP())
         self.problem.configure_ksp(snes.getKSP())
         return snes
+
+    def _configure_preconditioner(self, ksp: PETSc.KSP) -> None:
+        """The contact-block preconditioner for ``pc_type python`` (the
+        iterative default) and the rigid-body modes for multigrid."""
+        pc = ksp.getPC()
+        if pc.getType() == "gamg":
+            self.problem.attach_near_nullspace = True
+            self.problem.matrix().setNearNullSpace(self.problem.near_nullspace())
+        if pc.getType() == "python" and self.linear_solver == "iterative":
+            if self.preconditioner is None:
+                self.preconditioner = ContactBlockPreconditioner(
+                    self.problem.contact_rows, self.prefix, self.problem.near_nullspace)
+            pc.setPythonContext(self.preconditioner)
 
     def solve(self, update: Callable[[float], None], load_steps: int = 1,
               output: Optional[Union[str, Path]] = None, max_cuts: int = 5,
@@ -155,7 +189,7 @@ class LoadPathSolver:
                     clock = time.perf_counter()
                     x = u.vector.copy()
                     increment = path.increment(target) if path is not None else None
-                    reason, phases, iterations, cause, reference = self.newton_step(
+                    reason, phases, iterations, cause, reference, linear = self.newton_step(
                         snes, x, increment)
                     history = [r for phase in phases for r in phase]
                     if reason <= 0:
@@ -174,7 +208,8 @@ class LoadPathSolver:
                     states = [term.evaluate() for term in self.contacts]
                     active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
                     step = StepResult(target, iterations, history,
-                                      time.perf_counter() - clock, active, phases, reference)
+                                      time.perf_counter() - clock, active, phases, reference,
+                                      linear)
                     result.steps.append(step)
                     before = stepper.fraction_of_steps
                     stepper.succeeded()
@@ -194,10 +229,11 @@ class LoadPathSolver:
 
     def newton_step(self, snes: PETSc.SNES, x: PETSc.Vec,
                     increment: Optional[PETSc.Vec] = None
-                    ) -> tuple[int, list, int, str, float]:
+                    ) -> tuple[int, list, int, str, float, int]:
         """One load step's Newton solve from x (plus a predictor's ``increment``):
         SNES reason, the residual norms of each SNES solve, iterations, what
-        stopped it if it failed (in words), and the force scale F.
+        stopped it if it failed (in words), the force scale F and the Krylov
+        iterations.
 
         The step is accepted when ``‖R‖ ≤ rtol·F``
         (:class:`~dolfinx_mortar.solver.convergence.EquilibriumTest`) with F the
@@ -212,7 +248,7 @@ class LoadPathSolver:
         than the bulk's, and Newton cycled or diverged (Hertz 2D).
         """
         phases: list = []
-        iterations = 0
+        iterations = linear = 0
         b = self.problem.vector()
         self.problem.F(x, b)
         reference = b.norm()
@@ -224,10 +260,11 @@ class LoadPathSolver:
             reason = self._solve_phase(snes, x, frozen)
             phases.append([float(r) for r in snes.getConvergenceHistory()[0]])
             iterations += snes.getIterationNumber()
+            linear += snes.getLinearSolveIterations()
             if reason <= 0:
                 return (reason, phases, iterations,
-                        describe_failure(snes, self.equilibrium), reference)
-        return reason, phases, iterations, "", reference
+                        describe_failure(snes, self.equilibrium), reference, linear)
+        return reason, phases, iterations, "", reference, linear
 
     def _solve_phase(self, snes: PETSc.SNES, x: PETSc.Vec, frozen: bool) -> int:
         from contextlib import ExitStack
@@ -249,7 +286,8 @@ class LoadPathSolver:
 
     def _check_petsc_options(self) -> None:
         """Refuse options under the prefix that no PETSc object read (misspelled)."""
-        unused = unused_petsc_options(self.prefix, ignore=DEFAULT_OPTIONS)
+        unused = unused_petsc_options(self.prefix,
+                                      ignore={**DEFAULT_OPTIONS, **iterative_options(True)})
         if unused:
             raise ValueError(f"PETSc option(s) {', '.join(unused)} were set but not used by "
                              f"any solver of this problem: misspelled, or meant for another "

@@ -70,6 +70,10 @@ class NonlinearContactProblem:
         self.a = fem.form(J, form_compiler_params=fc, jit_params=jit)
         self._A: Optional[PETSc.Mat] = None
         self._b: Optional[PETSc.Vec] = None
+        self._near_nullspace: Optional[PETSc.NullSpace] = None
+        #: give the Jacobian matrix the rigid-body modes (for GAMG; set by the
+        #: solver when its preconditioner needs them)
+        self.attach_near_nullspace = False
         #: wall times of the bulk assembly, seconds (the contact's are in each term's timings)
         self.timings: dict[str, float] = {}
 
@@ -121,7 +125,37 @@ class NonlinearContactProblem:
             for term in self.contacts[1:]:
                 other = term.create_matrix(self.a, self.bcs)
                 self._A.axpy(1.0, other, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            if self.attach_near_nullspace:
+                self._A.setNearNullSpace(self.near_nullspace())
         return self._A
+
+    def near_nullspace(self) -> PETSc.NullSpace:
+        """The rigid-body modes of each body of the mesh
+        (:func:`~dolfinx_mortar.solver.near_nullspace.rigid_body_modes`), made once."""
+        if self._near_nullspace is None:
+            from dolfinx_mortar.solver.near_nullspace import rigid_body_modes
+            self._near_nullspace = rigid_body_modes(self.u.function_space)
+        return self._near_nullspace
+
+    def contact_rows(self) -> np.ndarray:
+        """Global indices of this rank's rows that the contact terms stiffened
+        at the last :meth:`J` (the exact block of
+        :class:`~dolfinx_mortar.solver.contact_block_pc.ContactBlockPreconditioner`)."""
+        rows = [term.stiffened_rows for term in self.contacts]
+        return np.unique(np.concatenate(rows)).astype(PETSc.IntType)
+
+    @property
+    def symmetric(self) -> bool:
+        """Whether the Newton matrix is symmetric: the nodal active set on the
+        initial or previous configuration, for every contact term."""
+        return all(term.options.active_set == "nodal"
+                   and term.basis_configuration in ("initial", "previous")
+                   for term in self.contacts)
+
+    @property
+    def num_dofs(self) -> int:
+        V = self.u.function_space
+        return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
 
     def refresh_matrix(self) -> PETSc.Mat:
         """A new :meth:`matrix` (the contact pattern changed)."""

@@ -11,6 +11,8 @@ from typing import Any, Mapping
 
 from petsc4py import PETSc
 
+from dolfinx_mortar.solver.linear_solver import DIRECT_OPTIONS
+
 #: PETSc options set unless the options database already has them
 DEFAULT_OPTIONS = {
     "snes_type": "newtonls",
@@ -27,12 +29,9 @@ DEFAULT_OPTIONS = {
     # the first step of a contact problem often overshoots into the obstacle
     # before the active set settles: do not call that divergence
     "snes_divergence_tolerance": -1,
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-    # MUMPS sizes its workspace from the analysis; parallel pivoting can exceed
-    # it (INFOG(1) = -9). 100% extra costs memory only.
-    "mat_mumps_icntl_14": 100,
+    # the linear solver: MUMPS unless the solver goes iterative
+    # (dolfinx_mortar.solver.linear_solver)
+    **DIRECT_OPTIONS,
 }
 
 

@@ -19,6 +19,8 @@ class StepResult:
     #: the step's force scale F: the out-of-balance force where it started
     #: (:class:`~dolfinx_mortar.solver.convergence.EquilibriumTest`)
     reference: float = float("nan")
+    #: Krylov iterations of the step's linear solves (1 per Newton iteration with LU)
+    linear_iterations: int = 0
 
     def terminal_iterations(self, near: float = 1e-3) -> int:
         """Newton iterations of the step's last solve after its residual first
@@ -43,3 +45,8 @@ class SolveResult:
     @property
     def newton_iterations(self) -> int:
         return sum(s.newton_iterations for s in self.steps)
+
+    @property
+    def linear_iterations(self) -> int:
+        """Krylov iterations over all steps."""
+        return sum(s.linear_iterations for s in self.steps)

@@ -1,0 +1,68 @@
+"""Which linear solver a Newton step uses: MUMPS LU, or a Krylov method
+preconditioned by multigrid plus an exact contact block.
+
+``"direct"``
+    MUMPS LU of the Newton matrix, every iteration (robust; memory and time
+    grow fast with the size in 3D).
+``"iterative"``
+    CG (the nodal active set on the initial or previous configuration: a
+    symmetric Newton matrix) or GMRES (pointwise active set, current
+    configuration), preconditioned by
+    :class:`~dolfinx_mortar.solver.contact_block_pc.ContactBlockPreconditioner`,
+    with Eisenstat–Walker forcing terms so that early Newton iterations are not
+    solved more accurately than they are worth.
+``"auto"``
+    ``"iterative"`` in 3D from :data:`ITERATIVE_FROM_DOFS` dofs on, ``"direct"``
+    otherwise and always for the GLS kinds (see README, "Linear solvers").
+
+Every option stays overridable under the solver's prefix
+(``-dolfinx_mortar_ksp_type``, ``-dolfinx_mortar_amg_pc_type gamg``, …).
+"""
+from __future__ import annotations
+
+LINEAR_SOLVERS = ("auto", "direct", "iterative")
+
+#: 3D problems from this many dofs on are solved iteratively by "auto": on
+#: Hertz 3D (two bodies) MUMPS and the iterative path cost the same per Newton
+#: iteration at about 30k dofs, and MUMPS's share grows from there
+#: (``benchmarks/krylov_scaling.py``)
+ITERATIVE_FROM_DOFS = 100_000
+
+DIRECT_OPTIONS = {
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+    # MUMPS sizes its workspace from the analysis; parallel pivoting can exceed
+    # it (INFOG(1) = -9). 100% extra costs memory only.
+    "mat_mumps_icntl_14": 100,
+}
+
+
+def iterative_options(symmetric: bool) -> dict:
+    """The Krylov path's options (without prefix)."""
+    return {
+        "ksp_type": "cg" if symmetric else "gmres",
+        "pc_type": "python",
+        # rtol is then the true residual's reduction, what the Newton test sees
+        "ksp_norm_type": "unpreconditioned",
+        "ksp_rtol": 1e-8,
+        "ksp_max_it": 1000,
+        "ksp_gmres_restart": 100,
+        # inexact Newton: KSP rtol from the nonlinear convergence (Eisenstat–Walker)
+        "snes_ksp_ew": True,
+    }
+
+
+def choose_linear_solver(requested: str, num_dofs: int, gdim: int, augmented: bool) -> str:
+    """``"direct"`` or ``"iterative"`` for a problem (see the module's text)."""
+    if requested not in LINEAR_SOLVERS:
+        raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {requested!r}")
+    if augmented:
+        if requested == "iterative":
+            raise NotImplementedError(
+                "the GLS kinds solve their augmented Newton system directly (MUMPS): "
+                "no iterative path for it yet (README, 'Linear solvers')")
+        return "direct"
+    if requested != "auto":
+        return requested
+    return "iterative" if gdim == 3 and num_dofs >= ITERATIVE_FROM_DOFS else "direct"

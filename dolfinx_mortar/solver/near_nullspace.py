@@ -1,0 +1,118 @@
+"""The rigid-body modes of each body: the near-nullspace that algebraic
+multigrid needs to coarsen elasticity.
+
+Smoothed-aggregation AMG (PETSc GAMG) builds its coarse spaces from the
+vectors a matrix attaches as its near-nullspace; without them it coarsens
+each displacement component as a scalar field and a penalty contact system
+stalls or breaks down (CG with GAMG stopped with ``DIVERGED_INDEFINITE_PC``
+on Hertz 3D). The bodies of a contact problem are separate components of one
+mesh: each has its own rigid motions, which the contact penalty couples only
+weakly, so the modes are built per body.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+import scipy.sparse
+import scipy.sparse.csgraph
+from dolfinx import fem, la
+from mpi4py import MPI
+from petsc4py import PETSc
+
+
+def body_labels(V: fem.FunctionSpace) -> np.ndarray:
+    """A label per local dof block (owned and ghost) that is the same on all
+    blocks of one connected body of the mesh and differs between bodies, on
+    every rank: the smallest global block index of the body.
+
+    Connected means sharing a dof of V (a vertex for Lagrange spaces).
+    """
+    imap = V.dofmap.index_map
+    n_local = imap.size_local + imap.num_ghosts
+    dofs = V.dofmap.list
+    cells = np.repeat(np.arange(dofs.num_nodes), np.diff(dofs.offsets))
+    # a bipartite graph of cells and blocks; its components are the bodies
+    n_cells = dofs.num_nodes
+    graph = scipy.sparse.coo_matrix(
+        (np.ones(len(cells)), (cells, n_cells + dofs.array)),
+        shape=(n_cells + n_local, n_cells + n_local))
+    _, component = scipy.sparse.csgraph.connected_components(graph, directed=False)
+    component = component[n_cells:]
+    global_index = imap.local_to_global(np.arange(n_local, dtype=np.int32))
+    # The parts of one body on different ranks meet at shared blocks: spread
+    # the smallest label over them until no rank changes (as many rounds as
+    # the body crosses partitions, plus one).
+    labels = la.create_petsc_vector(imap, 1)
+    comm = V.mesh.comm
+    label_of = np.full(component.max(initial=-1) + 1, np.inf)
+    np.minimum.at(label_of, component, global_index.astype(float))
+    while True:
+        with labels.localForm() as local:
+            local.array[:] = -label_of[component]
+        # MAX of the negated labels: the smallest label wins at owners
+        labels.ghostUpdate(addv=PETSc.InsertMode.MAX_VALUES, mode=PETSc.ScatterMode.REVERSE)
+        labels.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        with labels.localForm() as local:
+            seen = -local.array_r.copy()
+        new = label_of.copy()
+        np.minimum.at(new, component, seen)
+        changed = comm.allreduce(bool(np.any(new < label_of)), op=MPI.LOR)
+        label_of = new
+        if not changed:
+            break
+    labels.destroy()
+    return label_of[component].astype(np.int64)
+
+
+def rigid_body_modes(V: fem.FunctionSpace,
+                     bodies: Optional[np.ndarray] = None) -> PETSc.NullSpace:
+    """The rigid-body modes of each body of V's mesh as a PETSc near-nullspace
+    (orthonormal vectors): 3 per body in 2D (2 translations, 1 rotation), 6 in
+    3D.
+
+    Parameters
+    ----------
+    V
+        A vector Lagrange space (block size = geometric dimension).
+    bodies
+        A label per local dof block (:func:`body_labels` by default): equal
+        labels are one rigid body.
+    """
+    gdim = V.mesh.geometry.dim
+    bs = V.dofmap.index_map_bs
+    if bs != gdim:
+        raise ValueError(f"rigid-body modes need a vector space of block size {gdim}, got {bs}")
+    imap = V.dofmap.index_map
+    n_owned = imap.size_local
+    if bodies is None:
+        bodies = body_labels(V)
+    comm = V.mesh.comm
+    names = np.unique(np.concatenate(comm.allgather(np.unique(bodies[:n_owned]))))
+    x = V.tabulate_dof_coordinates()[:n_owned, :gdim]
+    # rotations about the body's own centre keep the vectors well scaled
+    rotations = [(0, 1)] if gdim == 2 else [(0, 1), (1, 2), (2, 0)]
+    vectors = []
+    for name in names:
+        mine = bodies[:n_owned] == name
+        count = comm.allreduce(int(mine.sum()))
+        centre = comm.allreduce(x[mine].sum(axis=0)) / max(count, 1)
+        xc = x - centre
+        for k in range(gdim):
+            mode = np.zeros((n_owned, bs))
+            mode[mine, k] = 1.0
+            vectors.append(mode)
+        for i, j in rotations:
+            mode = np.zeros((n_owned, bs))
+            mode[mine, i] = -xc[mine, j]
+            mode[mine, j] = xc[mine, i]
+            vectors.append(mode)
+    petsc_vectors = []
+    for mode in vectors:
+        v = la.create_petsc_vector(imap, bs)
+        with v.localForm() as local:
+            local.array[:n_owned * bs] = mode.ravel()
+        v.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        petsc_vectors.append(v)
+    la.orthonormalize(petsc_vectors)
+    return PETSc.NullSpace().create(vectors=petsc_vectors, comm=comm)

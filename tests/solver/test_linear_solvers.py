@@ -1,0 +1,158 @@
+"""The linear solvers of a Newton step: the iterative path (Krylov, multigrid,
+exact contact block) gives the direct path's solution, stays robust in the
+penalty, and the rigid-body modes are exact null vectors of the bulk."""
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, mesh
+from dolfinx.fem import petsc as fem_petsc
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar.solver.elastic import linear_elastic_residual
+from dolfinx_mortar.solver.linear_solver import ITERATIVE_FROM_DOFS, choose_linear_solver
+from dolfinx_mortar.solver.near_nullspace import body_labels, rigid_body_modes
+from support import load_demo
+from support.scenes import pressed_block
+
+
+def test_auto_goes_iterative_for_large_3d_problems_only():
+    assert choose_linear_solver("auto", ITERATIVE_FROM_DOFS, 3, False) == "iterative"
+    assert choose_linear_solver("auto", ITERATIVE_FROM_DOFS - 1, 3, False) == "direct"
+    assert choose_linear_solver("auto", 10 * ITERATIVE_FROM_DOFS, 2, False) == "direct"
+    assert choose_linear_solver("auto", 10 * ITERATIVE_FROM_DOFS, 3, True) == "direct"
+    assert choose_linear_solver("iterative", 10, 2, False) == "iterative"
+    with pytest.raises(ValueError, match="linear_solver must be one of"):
+        choose_linear_solver("krylov", 10, 2, False)
+    with pytest.raises(NotImplementedError, match="GLS kinds"):
+        choose_linear_solver("iterative", 10, 2, True)
+
+
+def _two_cubes(comm):
+    """Two unit cubes side by side, not touching: two bodies of one mesh."""
+    domain = mesh.create_box(comm, [[0, 0, 0], [2.5, 1, 1]], [5, 2, 2])
+    keep = mesh.locate_entities(domain, 3, lambda x: np.abs(x[0] - 1.25) > 0.5 - 1e-9)
+    domain.topology.create_connectivity(3, 0)
+    sub, _, _, _ = mesh.create_submesh(domain, 3, keep)
+    return sub
+
+
+@pytest.mark.parametrize("gdim", [2, 3])
+def test_rigid_body_modes_are_null_vectors_of_the_bulk(gdim):
+    comm = MPI.COMM_WORLD
+    if gdim == 3:
+        domain = _two_cubes(comm)
+    else:
+        domain = mesh.create_rectangle(comm, [[0, 0], [2.5, 1]], [10, 4])
+        keep = mesh.locate_entities(domain, 2, lambda x: np.abs(x[0] - 1.25) > 0.5 - 1e-9)
+        domain, _, _, _ = mesh.create_submesh(domain, 2, keep)
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    labels = body_labels(V)
+    bodies = np.unique(np.concatenate(comm.allgather(np.unique(labels))))
+    assert len(bodies) == 2
+    # the labels are the same on both copies of a shared dof block
+    u = fem.Function(V)
+    modes = rigid_body_modes(V).getVecs()
+    assert len(modes) == 2 * (3 if gdim == 2 else 6)
+    F = linear_elastic_residual(u, 1.0, 0.3)
+    K = fem_petsc.assemble_matrix(fem.form(ufl.derivative(F, u, ufl.TrialFunction(V))))
+    K.assemble()
+    scale = K.norm(PETSc.NormType.NORM_INFINITY)
+    for mode in modes:
+        Km = K.createVecLeft()
+        K.mult(mode, Km)
+        assert Km.norm(PETSc.NormType.NORM_INFINITY) < 1e-12 * scale * mode.norm(
+            PETSc.NormType.NORM_INFINITY)
+    # and they are orthonormal
+    gram = np.array([[a.dot(b) for b in modes] for a in modes])
+    assert np.allclose(gram, np.eye(len(modes)), atol=1e-12)
+
+
+def test_body_labels_agree_across_ranks():
+    comm = MPI.COMM_WORLD
+    V = fem.VectorFunctionSpace(_two_cubes(comm), ("Lagrange", 1))
+    labels = body_labels(V)
+    # owners and ghosts of one dof block agree on its body
+    imap = V.dofmap.index_map
+    vec = fem.Function(fem.FunctionSpace(V.mesh, ("Lagrange", 1)))
+    vec.x.array[:] = labels.astype(float)
+    before = vec.x.array.copy()
+    vec.x.scatter_forward()
+    assert np.array_equal(vec.x.array, before)
+    assert len(labels) == imap.size_local + imap.num_ghosts
+
+
+def _hertz3d(linear_solver: str, penalty: float, options: dict):
+    demo = load_demo("hertz3d")
+    args = demo.parse_args(["--obstacle", "elastic", "--refine", "0.5", "--penalty",
+                            str(penalty), "--linear-solver", linear_solver])
+    problem, context = demo.build_problem(args, MPI.COMM_WORLD)
+    db = PETSc.Options()
+    for key, value in options.items():
+        db["dolfinx_mortar_" + key] = value
+    try:
+        result = problem.solve(load_steps=args.load_steps)
+    finally:
+        for key in options:
+            db.delValue("dolfinx_mortar_" + key)
+    return problem, result
+
+
+@pytest.mark.slow
+def test_iterative_path_matches_mumps_and_is_robust_in_the_penalty():
+    """Hertz 3D, two bodies, ε = 1e4·E/h: CG + contact block + BoomerAMG with
+    a fixed Krylov tolerance gives MUMPS's displacement to the Krylov
+    tolerance, in few Krylov iterations per Newton iteration (BoomerAMG alone
+    needs several times more at this penalty)."""
+    direct, _ = _hertz3d("direct", 1e4, {})
+    iterative, result = _hertz3d("iterative", 1e4, {"snes_ksp_ew": "false"})
+    assert iterative.solver.linear_solver == "iterative"
+    difference = np.max(np.abs(direct.u.x.array - iterative.u.x.array))
+    size = np.max(np.abs(direct.u.x.array))
+    comm = MPI.COMM_WORLD
+    assert comm.allreduce(difference, op=MPI.MAX) < 1e-6 * comm.allreduce(size, op=MPI.MAX)
+    assert abs(iterative.normal_force() / direct.normal_force() - 1) < 1e-6
+    per_newton = result.linear_iterations / result.newton_iterations
+    assert per_newton < 40, per_newton
+    _, plain = _hertz3d("iterative", 1e4, {"snes_ksp_ew": "false", "pc_type": "hypre",
+                                            "pc_hypre_type": "boomeramg"})
+    assert plain.linear_iterations / plain.newton_iterations > 2 * per_newton
+
+
+@pytest.mark.parametrize("option", ["pc_type", "amg_pc_type"])
+def test_gamg_gets_the_rigid_body_modes_of_each_body(option):
+    """GAMG, asked for in place of the default multigrid or as the whole
+    preconditioner, coarsens with the 3 rigid-body modes of the 2D block."""
+    from dolfinx_mortar import RigidPlane
+    problem = pressed_block(RigidPlane([0.0, -0.001], [0.0, 1.0]), "LcLS*",
+                            linear_solver="iterative", petsc_options={option: "gamg"})
+    problem.set_load(0.0)
+    problem.solve(load_steps=1)
+    modes = problem.problem.matrix().getNearNullSpace().getVecs()
+    assert len(modes) == 3
+
+
+def test_iterative_path_in_2d_with_an_obstacle():
+    """Pointwise active set (GMRES) and nodal (CG) against a rigid plane match
+    their direct solutions."""
+    from dolfinx_mortar import RigidPlane
+    for active_set in ("nodal", "pointwise"):
+        solutions = []
+        for linear_solver in ("direct", "iterative"):
+            problem = pressed_block(RigidPlane([0.0, -0.001], [0.0, 1.0]), "LcLS",
+                                    active_set=active_set, linear_solver=linear_solver)
+            problem.set_load(0.0)
+            problem.solve(load_steps=2)
+            solutions.append(problem.u.x.array.copy())
+        ksp_type = "cg" if active_set == "nodal" else "gmres"
+        assert problem.solver.default_options()["ksp_type"] == ksp_type
+        scale = MPI.COMM_WORLD.allreduce(np.max(np.abs(solutions[0])), op=MPI.MAX)
+        difference = MPI.COMM_WORLD.allreduce(np.max(np.abs(solutions[0] - solutions[1])),
+                                              op=MPI.MAX)
+        assert difference < 1e-6 * scale
+
+
+def test_gls_refuses_the_iterative_path_by_name():
+    from dolfinx_mortar import RigidPlane
+    with pytest.raises(NotImplementedError, match="augmented"):
+        pressed_block(RigidPlane([0.0, -0.001], [0.0, 1.0]), "GLS", linear_solver="iterative")
