@@ -24,7 +24,7 @@ DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 # cell measures 5.6e-17 with SkylakeX kernels and 0 with Haswell's).
 SECOND_CORETYPE ?= Haswell
 
-.PHONY: help setup deps build install demo test test-cpp test-python test-mpi test-coretype bench bench-speed stress clean
+.PHONY: help setup deps build install demo test test-cpp test-python test-mpi test-coretype bench bench-speed bench-scale stress clean
 
 help:
 	@echo "make setup  - install missing Debian packages, build the kernels, make dolfinx_mortar importable"
@@ -33,6 +33,8 @@ help:
 	@echo "              pytest again with another CPU's BLAS kernels (OPENBLAS_CORETYPE)"
 	@echo "make bench  - setup, then the benchmarks in benchmarks/ (speed vs error: --quick)"
 	@echo "make bench-speed - setup, then the full speed-vs-error study (~25 min, serial)"
+	@echo "make bench-scale - setup, then Krylov iterations against h and penalty, and 1 against 2"
+	@echo "              ranks, on Hertz 3D with two bodies (~1.5 h; docs/SCALING.md)"
 	@echo "make stress - setup, then 1e6 generated slave-master pairs through 3D segmentation"
 
 setup: deps build install
@@ -88,6 +90,14 @@ bench: setup
 
 bench-speed: setup
 	$(PYTHON) benchmarks/speed_vs_error.py
+
+# docs/SCALING.md: the tables of the linear solvers
+bench-scale: setup
+	$(PYTHON) benchmarks/krylov_scaling.py --levels 0.5 1 2 --penalties 1e1 1e2 1e3 1e4 \
+		--solvers block-fixed block direct
+	$(PYTHON) benchmarks/krylov_scaling.py --levels 2 --penalties 1e3 --solvers block direct --tag n1
+	$(MPIRUN) $(PYTHON) benchmarks/krylov_scaling.py --levels 2 --penalties 1e3 \
+		--solvers block direct --tag n2
 
 stress: setup
 	$(BUILD_DIR)/kernels/stress_segmentation 1000000 1

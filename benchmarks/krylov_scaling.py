@@ -153,20 +153,26 @@ def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
                               f"{str(error).splitlines()[0]}", flush=True)
                     continue
                 if comm.rank == 0:
+                    write_results(rows, args, load)  # after each run: a long study
                     r = rows[-1]
                     print(f"{solver} refine {refine:g} ε {penalty:.0e}: {r['dofs']} dofs, "
                           f"Newton {r['newton']}, Krylov/Newton {r['krylov_per_newton']:.1f}, "
                           f"{r['wall_time']:.1f} s", flush=True)
                 gc.collect()
     if comm.rank == 0:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        stem = "krylov_scaling" + (f"_{args.tag}" if args.tag else "")
-        table = markdown(rows, load)
-        print(table)
-        write_csv(out / f"{stem}.csv", rows, COLUMNS)
-        write_atomically(out / f"{stem}.md", lambda tmp: Path(tmp).write_text(table))
+        print(markdown(rows, load))
     return rows
+
+
+def write_results(rows: list[dict], args: argparse.Namespace, load: float) -> None:
+    """The table so far as CSV and markdown (atomically: an interrupted study
+    leaves the rows it finished)."""
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    stem = "krylov_scaling" + (f"_{args.tag}" if args.tag else "")
+    table = markdown(rows, load)
+    write_csv(out / f"{stem}.csv", rows, COLUMNS)
+    write_atomically(out / f"{stem}.md", lambda tmp: Path(tmp).write_text(table))
 
 
 if __name__ == "__main__":

@@ -13,7 +13,7 @@ preconditioned by multigrid plus an exact contact block.
     solved more accurately than they are worth.
 ``"auto"``
     ``"iterative"`` in 3D from :data:`ITERATIVE_FROM_DOFS` dofs on, ``"direct"``
-    otherwise and always for the GLS kinds (see README, "Linear solvers").
+    otherwise and always for the GLS kinds (README, "Linear solvers"; docs/SCALING.md).
 
 Every option stays overridable under the solver's prefix
 (``-dolfinx_mortar_ksp_type``, ``-dolfinx_mortar_amg_pc_type gamg``, …).
@@ -61,7 +61,7 @@ def choose_linear_solver(requested: str, num_dofs: int, gdim: int, augmented: bo
         if requested == "iterative":
             raise NotImplementedError(
                 "the GLS kinds solve their augmented Newton system directly (MUMPS): "
-                "no iterative path for it yet (README, 'Linear solvers')")
+                "no iterative path for it yet (README, 'Linear solvers'; docs/SCALING.md)")
         return "direct"
     if requested != "auto":
         return requested

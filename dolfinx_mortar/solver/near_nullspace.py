@@ -89,7 +89,7 @@ def rigid_body_modes(V: fem.FunctionSpace,
         bodies = body_labels(V)
     comm = V.mesh.comm
     names = np.unique(np.concatenate(comm.allgather(np.unique(bodies[:n_owned]))))
-    x = V.tabulate_dof_coordinates()[:n_owned, :gdim]
+    x = _owned_node_coordinates(V)
     # rotations about the body's own centre keep the vectors well scaled
     rotations = [(0, 1)] if gdim == 2 else [(0, 1), (1, 2), (2, 0)]
     vectors = []
@@ -116,3 +116,32 @@ def rigid_body_modes(V: fem.FunctionSpace,
         petsc_vectors.append(v)
     la.orthonormalize(petsc_vectors)
     return PETSc.NullSpace().create(vectors=petsc_vectors, comm=comm)
+
+
+def _owned_node_coordinates(V: fem.FunctionSpace) -> np.ndarray:
+    """Coordinates of the owned dof blocks (nodes), shape (owned, gdim).
+
+    A rank may own a node that none of its cells holds (seen on a 2-rank
+    submesh): only cells give coordinates, so each copy that a local cell
+    holds contributes and the owner takes their mean.
+    tabulate_dof_coordinates leaves such a node unset (a rotation mode then
+    had ‖K m‖ = 1).
+    """
+    gdim = V.mesh.geometry.dim
+    bs = V.dofmap.index_map_bs
+    imap = V.dofmap.index_map
+    position = fem.Function(V)
+    position.interpolate(lambda x: x[:gdim])
+    held = np.zeros(imap.size_local + imap.num_ghosts)
+    held[V.dofmap.list.array] = 1.0
+    sums = la.create_petsc_vector(imap, bs + 1)
+    with sums.localForm() as local:
+        values = local.array.reshape(-1, bs + 1)
+        values[:, :bs] = position.x.array.reshape(-1, bs) * held[:, None]
+        values[:, bs] = held
+    sums.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    owned = sums.array_r.reshape(-1, bs + 1)
+    x = owned[:, :gdim] / owned[:, bs:]
+    sums.destroy()
+    return x
+

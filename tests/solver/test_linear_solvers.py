@@ -107,10 +107,10 @@ def test_iterative_path_matches_mumps_and_is_robust_in_the_penalty():
     direct, _ = _hertz3d("direct", 1e4, {})
     iterative, result = _hertz3d("iterative", 1e4, {"snes_ksp_ew": "false"})
     assert iterative.solver.linear_solver == "iterative"
-    difference = np.max(np.abs(direct.u.x.array - iterative.u.x.array))
-    size = np.max(np.abs(direct.u.x.array))
-    comm = MPI.COMM_WORLD
-    assert comm.allreduce(difference, op=MPI.MAX) < 1e-6 * comm.allreduce(size, op=MPI.MAX)
+    # each build meshes and partitions anew: compare what the dof order does not change
+    for norm in (PETSc.NormType.NORM_1, PETSc.NormType.NORM_2, PETSc.NormType.NORM_INFINITY):
+        assert iterative.u.vector.norm(norm) == pytest.approx(direct.u.vector.norm(norm),
+                                                              rel=1e-6)
     assert abs(iterative.normal_force() / direct.normal_force() - 1) < 1e-6
     per_newton = result.linear_iterations / result.newton_iterations
     assert per_newton < 40, per_newton
