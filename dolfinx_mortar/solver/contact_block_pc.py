@@ -15,7 +15,7 @@ them exactly and leaves the rest to multigrid, as a symmetric multiplicative
     e  = e₂ + A_cc⁻¹ (r − A e₂)_c
 
 It is symmetric when A is, so CG may use it: 20 … 22 iterations on the same
-matrices, and 17–21 Krylov iterations per Newton iteration in the solver from
+matrices, and 15–23 Krylov iterations per Newton iteration in the solver from
 12.7k to 81k dofs and ε = 1e1 … 1e4·E/h (docs/SCALING.md).
 
 Options, under the solver's prefix: ``amg_`` for the multigrid (a ``preonly``
