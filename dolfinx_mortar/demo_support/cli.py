@@ -48,7 +48,7 @@ def add_contact_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--linear-solver", default="auto",
                         choices=("auto", "direct", "iterative"),
                         help="MUMPS, Krylov + multigrid + exact contact block, or by size "
-                             "(auto: iterative for 3D from 100k dofs)")
+                             "(auto: iterative for 3D from 50k dofs)")
     parser.add_argument("--basis-configuration", default="initial",
                         choices=("initial", "previous", "current"),
                         help="configuration of the bases: initial, previous step, current")
