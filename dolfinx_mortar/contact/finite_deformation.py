@@ -38,6 +38,7 @@ from dolfinx_mortar.kinds import DUAL_KINDS, KindLike, is_global, is_partition_o
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.contact.obstacles import RigidObstacle
+from dolfinx_mortar.contact.sparse_products import transpose_mat_mult
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -235,7 +236,7 @@ class CurrentSurfaceGap(GapModelBase):
         if not geometric:
             right = state.G_y.copy()
             right.diagonalScale(layout.vector(self.weights * active), None)
-            return state.G_y.transposeMatMult(right)
+            return transpose_mat_mult(state.G_y, right)
         _, _, _, Fgg, FgW, FWW = self._nodal_coefficients(state.g, state.W, active)
 
         def scaled(M: PETSc.Mat, s: FloatArray) -> PETSc.Mat:
@@ -249,8 +250,8 @@ class CurrentSurfaceGap(GapModelBase):
         left.axpy(1.0, scaled(state.G_W, FgW), structure=Different)
         right = scaled(state.G_g, FgW)
         right.axpy(1.0, scaled(state.G_W, FWW), structure=Different)
-        K = state.G_g.transposeMatMult(left)
-        K.axpy(1.0, state.G_W.transposeMatMult(right), structure=Different)
+        K = transpose_mat_mult(state.G_g, left)
+        K.axpy(1.0, transpose_mat_mult(state.G_W, right), structure=Different)
         # second derivatives: Σ_A F_W,A ∂²W_A here, Σ_A F_g,A ∂²ĝ_A from the source
         cells = self.slave.cells
         nc, nd = cells.shape

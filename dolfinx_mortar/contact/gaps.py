@@ -39,6 +39,7 @@ from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.pointwise import MortarPointGaps, obstacle_positive_gaps
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
+from dolfinx_mortar.contact.sparse_products import transpose_mat_mult
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -157,7 +158,7 @@ class GapModelBase:
             G_right, weights = state.G_plus, self.weights
         SG = G_right.copy()
         SG.diagonalScale(self.slave.layout.vector(weights), None)
-        K = state.G.transposeMatMult(SG)
+        K = transpose_mat_mult(state.G, SG)
         if state.K_curv is not None:
             K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return K
@@ -165,7 +166,7 @@ class GapModelBase:
     def pattern(self, state: ContactState) -> PETSc.Mat:
         """A matrix with every entry the contact stiffness may have (``GᵀG``
         and the curvature: the pointwise ``GᵀG⁺`` and the nodal fallback are in it)."""
-        K = state.G.transposeMatMult(state.G)
+        K = transpose_mat_mult(state.G, state.G)
         if state.K_curv is not None:
             K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return K
