@@ -74,6 +74,9 @@ def fit_hertz_profile(r: np.ndarray, p: np.ndarray, a_hertz: float) -> HertzFit:
 
     # a is bounded away from 0 so that the profile stays defined; both
     # unknowns are scaled by their starting values
+    # tolerances far below any error quoted, so that where the iteration
+    # stops does not depend on the CPU's round-off
     fit = least_squares(residual, [p_max, a_hertz], x_scale=[p_max, a_hertz],
-                        bounds=([0.0, 1e-3 * a_hertz], [np.inf, WINDOW * a_hertz]))
+                        bounds=([0.0, 1e-3 * a_hertz], [np.inf, WINDOW * a_hertz]),
+                        xtol=1e-13, ftol=1e-13, gtol=1e-13)
     return HertzFit(float(fit.x[0]), float(fit.x[1]), p_max, int(len(r)))
