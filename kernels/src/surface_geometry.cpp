@@ -1,6 +1,7 @@
 // Copyright (C) 2026 dolfinx_mortar developers
 // SPDX-License-Identifier: MIT
 #include <dolfinx_mortar/geometric_tolerance.h>
+#include <dolfinx_mortar/pair_segmentation.h>
 #include <dolfinx_mortar/surface_geometry.h>
 
 #include <Eigen/Dense>
@@ -12,6 +13,15 @@
 
 namespace dolfinx_mortar
 {
+
+void
+gather_cell_nodes(const FacetSurface& s, std::size_t c, std::span<double> out)
+{
+  const int nn = facet_num_nodes(s.type);
+  const std::int32_t* nodes = s.cells.data() + c * nn;
+  for (int i = 0; i < nn; ++i)
+    std::copy_n(s.x.data() + nodes[i] * s.gdim, s.gdim, out.data() + i * s.gdim);
+}
 
 void
 FacetSurface::check() const
@@ -52,21 +62,12 @@ facet_geometry(const FacetSurface& s,
                Point3& x,
                std::array<Point3, 2>& tangents)
 {
-  const int nn = facet_num_nodes(s.type), tdim = facet_tdim(s.type);
-  facet_shape_functions(s.type, X, N, dN);
-  x = { 0, 0, 0 };
-  tangents = { Point3{ 0, 0, 0 }, Point3{ 0, 0, 0 } };
-  const std::int32_t* nodes = s.cells.data() + c * nn;
-  for (int i = 0; i < nn; ++i)
-  {
-    const double* xi = s.x.data() + nodes[i] * s.gdim;
-    for (int k = 0; k < s.gdim; ++k)
-    {
-      x[k] += N[i] * xi[k];
-      for (int j = 0; j < tdim; ++j)
-        tangents[j][k] += dN[j * nn + i] * xi[k];
-    }
-  }
+  std::array<double, 27> nodes; // at most 9 nodes × 3
+  const int nn = facet_num_nodes(s.type);
+  gather_cell_nodes(s, c, nodes);
+  cell_geometry<double>(s.type, s.gdim,
+                        std::span<const double>(nodes.data(), nn * s.gdim),
+                        X, N, dN, x, tangents);
 }
 
 Point3
@@ -177,8 +178,27 @@ project_along(const FacetSurface& s,
               const Point3& direction,
               std::array<double, 2> X0)
 {
-  const int nn = facet_num_nodes(s.type), tdim = facet_tdim(s.type);
-  const int n = s.gdim;         // unknowns: tdim reference coordinates and t
+  std::array<double, 27> nodes; // at most 9 nodes × 3
+  gather_cell_nodes(s, c, nodes);
+  return project_along(
+    s.type,
+    s.gdim,
+    std::span<const double>(nodes.data(), facet_num_nodes(s.type) * s.gdim),
+    p,
+    direction,
+    X0);
+}
+
+Projection
+project_along(FacetType type,
+              int gdim,
+              std::span<const double> cell_nodes,
+              const Point3& p,
+              const Point3& direction,
+              std::array<double, 2> X0)
+{
+  const int nn = facet_num_nodes(type), tdim = facet_tdim(type);
+  const int n = gdim;           // unknowns: tdim reference coordinates and t
   std::array<double, 9> Nbuf;   // at most 9 nodes
   std::array<double, 18> dNbuf; // tdim * nodes
   Projection out{ X0, 0.0, false };
@@ -188,17 +208,13 @@ project_along(const FacetSurface& s,
   // x(X) grows with |x|, so an absolute tolerance fails far from the origin.
   // The same scale judges a singular Jacobian and a step at round-off.
   double size = 0, position = 0;
-  {
-    const std::int32_t* nodes = s.cells.data() + c * nn;
-    const double* x0 = s.x.data() + nodes[0] * s.gdim;
-    for (int i = 0; i < nn; ++i)
-      for (int k = 0; k < s.gdim; ++k)
-      {
-        const double v = s.x[nodes[i] * s.gdim + k];
-        size = std::max(size, std::abs(v - x0[k]));
-        position = std::max(position, std::abs(v));
-      }
-  }
+  for (int i = 0; i < nn; ++i)
+    for (int k = 0; k < gdim; ++k)
+    {
+      const double v = cell_nodes[i * gdim + k];
+      size = std::max(size, std::abs(v - cell_nodes[k]));
+      position = std::max(position, std::abs(v));
+    }
   const double scale = std::max(
     { size, position, std::abs(p[0]), std::abs(p[1]), std::abs(p[2]) });
   // Newton's residual target: a few round-offs of x(X), far below the zero
@@ -208,13 +224,14 @@ project_along(const FacetSurface& s,
     std::max(geometric_tolerance * scale, std::numeric_limits<double>::min());
   for (int it = 0; it < 30; ++it)
   {
-    facet_geometry(s,
-                   c,
-                   std::span(out.X.data(), tdim),
-                   std::span(Nbuf.data(), nn),
-                   std::span(dNbuf.data(), tdim * nn),
-                   x,
-                   t);
+    cell_geometry<double>(type,
+                          gdim,
+                          cell_nodes,
+                          std::span<const double>(out.X.data(), tdim),
+                          std::span(Nbuf.data(), nn),
+                          std::span(dNbuf.data(), tdim * nn),
+                          x,
+                          t);
     Eigen::Matrix3d J = Eigen::Matrix3d::Identity();
     Eigen::Vector3d F(0, 0, 0);
     double residual = 0;

@@ -29,6 +29,10 @@ struct FacetSurface
 
 using Point3 = std::array<double, 3>;
 
+/// Copy the node coordinates of cell @p c, (nodes, gdim), into @p out.
+void
+gather_cell_nodes(const FacetSurface& s, std::size_t c, std::span<double> out);
+
 /// Position x(X) and tangents ∂x/∂X_k (2D: z = 0) of cell @p c.
 void
 facet_geometry(const FacetSurface& s,
@@ -81,6 +85,15 @@ struct Projection
 Projection
 project_along(const FacetSurface& s,
               std::size_t c,
+              const Point3& p,
+              const Point3& direction,
+              std::array<double, 2> X0);
+
+/// project_along on a cell given by its node coordinates (nodes, gdim).
+Projection
+project_along(FacetType type,
+              int gdim,
+              std::span<const double> cell_nodes,
               const Point3& p,
               const Point3& direction,
               std::array<double, 2> X0);

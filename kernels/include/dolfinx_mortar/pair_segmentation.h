@@ -1,0 +1,458 @@
+// Copyright (C) 2026 dolfinx_mortar developers
+// SPDX-License-Identifier: MIT
+#pragma once
+
+// The segmentation and integration of one slave–master cell pair, written
+// once for any scalar type: double gives the values (mortar_integrals), a
+// Jet gives the same values with their exact first and second derivatives
+// with respect to the pair's node coordinates and nodal normals
+// (current_pair_gaps). Every branch is decided on values, so that both
+// instantiations take the same branches.
+
+#include "clipping.h"
+#include "facet_element.h"
+#include "geometric_tolerance.h"
+#include "jet.h"
+#include "surface_geometry.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <numbers>
+#include <optional>
+#include <span>
+#include <type_traits>
+#include <vector>
+
+namespace dolfinx_mortar
+{
+
+template<typename T>
+using Vec3 = std::array<T, 3>;
+
+namespace vec3
+{
+template<typename T>
+T
+dot(const Vec3<T>& a, const Vec3<T>& b)
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+template<typename T>
+Vec3<T>
+sub(const Vec3<T>& a, const Vec3<T>& b)
+{
+  return { a[0] - b[0], a[1] - b[1], a[2] - b[2] };
+}
+template<typename T>
+Vec3<T>
+cross(const Vec3<T>& a, const Vec3<T>& b)
+{
+  return { a[1] * b[2] - a[2] * b[1],
+           a[2] * b[0] - a[0] * b[2],
+           a[0] * b[1] - a[1] * b[0] };
+}
+template<typename T>
+T
+norm(const Vec3<T>& a)
+{
+  return sqrt(dot(a, a));
+}
+template<typename T>
+Point3
+values(const Vec3<T>& a)
+{
+  return { value(a[0]), value(a[1]), value(a[2]) };
+}
+} // namespace vec3
+
+/// |a|, with the sign decided on the value.
+template<typename T>
+T
+absolute(const T& a)
+{
+  return value(a) < 0 ? T(-a) : a;
+}
+
+/// Position x(X) and tangents ∂x/∂X_k of a cell given by its node
+/// coordinates @p nodes (nodes, gdim); 2D: z = 0.
+template<typename T>
+void
+cell_geometry(FacetType type,
+              int gdim,
+              std::span<const T> nodes,
+              std::span<const T> X,
+              std::span<T> N,
+              std::span<T> dN,
+              Vec3<T>& x,
+              std::array<Vec3<T>, 2>& tangents)
+{
+  const int nn = facet_num_nodes(type), tdim = facet_tdim(type);
+  shape_functions<T>(type, X, N, dN);
+  x = { 0.0, 0.0, 0.0 };
+  tangents = { Vec3<T>{ 0.0, 0.0, 0.0 }, Vec3<T>{ 0.0, 0.0, 0.0 } };
+  for (int i = 0; i < nn; ++i)
+  {
+    const T* xi = nodes.data() + i * gdim;
+    for (int k = 0; k < gdim; ++k)
+    {
+      x[k] += N[i] * xi[k];
+      for (int j = 0; j < tdim; ++j)
+        tangents[j][k] += dN[j * nn + i] * xi[k];
+    }
+  }
+}
+
+/// A flat piece of a facet: its reference polygon's centre, its physical
+/// polygon, and the plane (line in 2D) through its centre.
+template<typename T>
+struct SubFacet
+{
+  std::array<double, 2> reference_centre;
+  std::vector<Vec3<T>> polygon;
+  Vec3<T> centre, normal, e1, e2;
+  T size; ///< length (2D) or area (3D)
+};
+
+/// The longest edge of a polygon, on the values (it only takes decisions).
+template<typename Point>
+double
+longest_edge(const std::vector<Point>& polygon)
+{
+  double longest = 0;
+  for (std::size_t i = 0; i < polygon.size(); ++i)
+  {
+    const Point& p = polygon[i];
+    const Point& q = polygon[(i + 1) % polygon.size()];
+    double d = 0;
+    for (std::size_t k = 0; k < p.size(); ++k)
+      d += (value(q[k]) - value(p[k])) * (value(q[k]) - value(p[k]));
+    longest = std::max(longest, std::sqrt(d));
+  }
+  return longest;
+}
+
+/// The flat piece of a cell (node coordinates @p nodes) over the reference
+/// polygon, or nothing when it is degenerate: its length (2D) or its height,
+/// twice its area over its longest edge (3D), at most @p zero. Judged
+/// against the geometry's zero length, not against the piece's own extent:
+/// a collinear triangle has a round-off area that grows with |x|, and a
+/// sliver 1e-8 of its length is real input.
+template<typename T>
+std::optional<SubFacet<T>>
+make_subfacet(FacetType type,
+              int gdim,
+              std::span<const T> nodes,
+              const std::vector<std::array<double, 2>>& reference,
+              double zero)
+{
+  using namespace vec3;
+  const int tdim = facet_tdim(type), nn = facet_num_nodes(type);
+  std::vector<T> N(nn), dN(tdim * nn);
+  SubFacet<T> f;
+  f.reference_centre = { 0, 0 };
+  f.centre = { 0.0, 0.0, 0.0 };
+  std::array<Vec3<T>, 2> tangents;
+  for (const auto& X : reference)
+  {
+    const std::array<T, 2> XT = { X[0], X[1] };
+    Vec3<T> x;
+    cell_geometry<T>(
+      type, gdim, nodes, std::span<const T>(XT.data(), tdim), N, dN, x, tangents);
+    f.polygon.push_back(x);
+    for (int k = 0; k < 3; ++k)
+      f.centre[k] += x[k] / static_cast<double>(reference.size());
+    for (int k = 0; k < 2; ++k)
+      f.reference_centre[k] += X[k] / reference.size();
+  }
+  const auto& P = f.polygon;
+  // !(a > b) rather than a <= b: NaN is degenerate too
+  if (gdim == 2)
+  {
+    const Vec3<T> t = sub(P[1], P[0]);
+    f.size = norm(t);
+    if (!(value(f.size) > zero))
+      return std::nullopt;
+    f.e1 = { t[0] / f.size, t[1] / f.size, 0.0 };
+    f.normal = { f.e1[1], -f.e1[0], 0.0 };
+    f.e2 = { 0.0, 0.0, 0.0 };
+    return f;
+  }
+  // |n| is twice the area of a triangle, and of a quadrilateral's projection
+  // on the plane normal to n (the cross product of its diagonals)
+  Vec3<T> n = P.size() == 3 ? cross(sub(P[1], P[0]), sub(P[2], P[0]))
+                            : cross(sub(P[2], P[0]), sub(P[3], P[1]));
+  const T n_norm = norm(n);
+  if (!(value(n_norm) > zero * longest_edge(P)))
+    return std::nullopt;
+  for (T& v : n)
+    v /= n_norm;
+  f.normal = n;
+  Vec3<T> e1 = sub(P[1], P[0]);
+  const T along = dot(e1, n);
+  for (int k = 0; k < 3; ++k)
+    e1[k] -= along * n[k];
+  const T e1_norm = norm(e1);
+  if (!(value(e1_norm) > zero)) // a quadrilateral with a collapsed first edge
+    return std::nullopt;
+  for (T& v : e1)
+    v /= e1_norm;
+  f.e1 = e1;
+  f.e2 = cross(n, e1);
+  // area of the polygon projected on its own plane: |n|/2 up to round-off,
+  // so positive after the height test
+  std::vector<std::array<T, 2>> flat;
+  for (const Vec3<T>& p : P)
+    flat.push_back({ dot(sub(p, f.centre), f.e1), dot(sub(p, f.centre), f.e2) });
+  f.size = absolute(signed_area(flat));
+  return f;
+}
+
+/// Two Newton steps for x(X) = p + t·direction from a projection converged
+/// on the values: the first makes the first derivatives of (X, t) exact,
+/// the second the second derivatives (the implicit function theorem; Newton's
+/// map has zero slope at its root). The 2×2 or 3×3 systems are solved by
+/// Cramer's rule, which any scalar type can carry.
+template<typename T>
+std::pair<std::array<T, 2>, T>
+refine_projection(FacetType type,
+                  int gdim,
+                  std::span<const T> nodes,
+                  const Vec3<T>& p,
+                  const Vec3<T>& direction,
+                  const Projection& start)
+{
+  const int tdim = facet_tdim(type), nn = facet_num_nodes(type);
+  std::array<T, 2> X = { start.X[0], start.X[1] };
+  T t = start.t;
+  std::vector<T> N(nn), dN(tdim * nn);
+  for (int step = 0; step < 2; ++step)
+  {
+    Vec3<T> x;
+    std::array<Vec3<T>, 2> tangents;
+    cell_geometry<T>(
+      type, gdim, nodes, std::span<const T>(X.data(), tdim), N, dN, x, tangents);
+    Vec3<T> F;
+    for (int k = 0; k < gdim; ++k)
+      F[k] = x[k] - p[k] - t * direction[k];
+    const auto& a = tangents[0];
+    if (gdim == 2)
+    {
+      // columns (a, −direction)
+      const T det = a[0] * (-direction[1]) + a[1] * direction[0];
+      const T d0 = (F[0] * (-direction[1]) + F[1] * direction[0]) / det;
+      const T d1 = (a[0] * F[1] - F[0] * a[1]) / det;
+      X[0] -= d0;
+      t -= d1;
+      continue;
+    }
+    const auto& b = tangents[1];
+    const Vec3<T> c = { -direction[0], -direction[1], -direction[2] };
+    // Cramer: δ_j = det(J with column j replaced by F) / det J
+    const T det = vec3::dot(a, vec3::cross(b, c));
+    const T d0 = vec3::dot(F, vec3::cross(b, c)) / det;
+    const T d1 = vec3::dot(a, vec3::cross(F, c)) / det;
+    const T d2 = vec3::dot(a, vec3::cross(b, F)) / det;
+    X[0] -= d0;
+    X[1] -= d1;
+    t -= d2;
+  }
+  return { X, t };
+}
+
+/// What one segment quadrature point gives its callback.
+template<typename T>
+struct SegmentPoint
+{
+  T weight;                  ///< quadrature weight × measure
+  std::span<const T> slave_N;  ///< N_A at the slave point
+  std::span<const T> master_N; ///< N^m_C at the master point
+  T gap;                     ///< d = (x_s − x_m)·n/|n|
+  Vec3<T> normal;            ///< interpolated nodal normal n (not unit)
+  T normal_norm;             ///< |n|
+  bool normal_defined;       ///< |n| above the geometric tolerance
+};
+
+/// Segment one slave–master cell pair and call @p on_point at every
+/// segment quadrature point (see mortar_integrals for the construction).
+///
+/// @param[in] slave_nodes, master_nodes Node coordinates (nodes, gdim)
+/// @param[in] slave_normals Unit nodal normals of the slave cell (nodes,
+/// gdim)
+/// @param[in] zero The zero length of every geometric decision
+/// @return The number of quadrature points whose projection failed
+/// (skipped)
+template<typename T, typename OnPoint>
+std::int64_t
+integrate_pair(FacetType slave_type,
+               FacetType master_type,
+               int gdim,
+               std::span<const T> slave_nodes,
+               std::span<const T> slave_normals,
+               std::span<const T> master_nodes,
+               std::span<const double> points,
+               std::span<const double> weights,
+               double zero,
+               bool opposing_normals_only,
+               bool axisymmetric,
+               OnPoint&& on_point)
+{
+  using namespace vec3;
+  using P2 = std::array<T, 2>;
+  const int tdim = gdim - 1;
+  const int ns = facet_num_nodes(slave_type), nm = facet_num_nodes(master_type);
+  const std::size_t nq = weights.size();
+  std::vector<double> slave_values(slave_nodes.size()),
+    master_values(master_nodes.size());
+  std::transform(slave_nodes.begin(), slave_nodes.end(), slave_values.begin(),
+                 [](const T& v) { return value(v); });
+  std::transform(master_nodes.begin(), master_nodes.end(), master_values.begin(),
+                 [](const T& v) { return value(v); });
+  std::vector<T> Ns(ns), dNs(tdim * ns), Nm(nm), dNm(tdim * nm);
+  std::array<Vec3<T>, 2> tangents;
+  std::vector<SubFacet<T>> master_subfacets;
+  for (const auto& piece : facet_subfacets(master_type))
+    if (auto f = make_subfacet<T>(master_type, gdim, master_nodes, piece, zero))
+      master_subfacets.push_back(std::move(*f));
+
+  std::int64_t failed = 0;
+  for (const auto& piece : facet_subfacets(slave_type))
+  {
+    const auto sf = make_subfacet<T>(slave_type, gdim, slave_nodes, piece, zero);
+    if (!sf)
+      continue;
+    auto plane_coords = [&](const Vec3<T>& x) -> P2
+    {
+      const Vec3<T> r = sub(x, sf->centre);
+      return { dot(r, sf->e1), dot(r, sf->e2) };
+    };
+    std::vector<P2> slave_polygon;
+    for (const Vec3<T>& x : sf->polygon)
+      slave_polygon.push_back(plane_coords(x));
+
+    for (const SubFacet<T>& mf : master_subfacets)
+    {
+      // unit normals of non-degenerate pieces: a perpendicular master
+      // projects to a segment and covers nothing on either side of 0
+      if (opposing_normals_only and value(dot(mf.normal, sf->normal)) >= 0)
+        continue;
+      std::vector<P2> master_polygon;
+      for (const Vec3<T>& x : mf.polygon)
+        master_polygon.push_back(plane_coords(x));
+
+      // Integration cells in plane coordinates: (origin, edge a, edge b)
+      // with measure factor; 2D cells have no edge b.
+      struct Cell
+      {
+        P2 origin, a, b;
+        T measure;
+      };
+      std::vector<Cell> cells;
+      if (gdim == 2)
+      {
+        const T lo = larger(slave_polygon[0][0],
+                            smaller(master_polygon[0][0], master_polygon[1][0]));
+        const T hi = smaller(slave_polygon[1][0],
+                             larger(master_polygon[0][0], master_polygon[1][0]));
+        const T length = hi - lo;
+        if (value(length) > zero)
+          cells.push_back({ { lo, 0.0 }, { length, 0.0 }, { 0.0, 0.0 }, length });
+      }
+      else
+      {
+        // The slave polygon is counter-clockwise about its own normal by
+        // construction; the master one is usually clockwise (it faces the
+        // slave) and must be turned for clipping. It is not degenerate, so
+        // the sign of its area is not round-off.
+        if (value(signed_area(master_polygon)) < 0)
+          std::reverse(master_polygon.begin(), master_polygon.end());
+        const auto clipped = clip_polygon(slave_polygon, master_polygon, zero);
+        // an overlap no wider than the zero length is a segment or a
+        // point (touching edges, a shared vertex)
+        if (clipped.size() < 3 or
+            !(2 * value(signed_area(clipped)) > zero * longest_edge(clipped)))
+          continue;
+        const double m = static_cast<double>(clipped.size());
+        P2 g = { 0.0, 0.0 };
+        for (const P2& q : clipped)
+          g = { g[0] + q[0] / m, g[1] + q[1] / m };
+        for (std::size_t i = 0; i < clipped.size(); ++i)
+        {
+          const P2& q0 = clipped[i];
+          const P2& q1 = clipped[(i + 1) % clipped.size()];
+          const P2 a = { q0[0] - g[0], q0[1] - g[1] };
+          const P2 b = { q1[0] - g[0], q1[1] - g[1] };
+          const T twice_area = a[0] * b[1] - a[1] * b[0];
+          // Exact sign test: the polygon is convex, wider than the zero
+          // length, and fanned from its centroid, so its fan triangles
+          // are positive up to round-off; a round-off one carries a
+          // round-off weight whichever way it is decided, while a
+          // length-based threshold would drop the fan of a thin overlap.
+          if (value(twice_area) > 0)
+            cells.push_back({ g, a, b, twice_area });
+        }
+      }
+
+      const Point3 direction = values(sf->normal);
+      for (const Cell& cell : cells)
+        for (std::size_t q = 0; q < nq; ++q)
+        {
+          const double X0 = points[q * tdim];
+          const double X1 = tdim == 2 ? points[q * tdim + 1] : 0.0;
+          const T u = cell.origin[0] + X0 * cell.a[0] + X1 * cell.b[0];
+          const T v = cell.origin[1] + X0 * cell.a[1] + X1 * cell.b[1];
+          Vec3<T> x;
+          for (int k = 0; k < 3; ++k)
+            x[k] = sf->centre[k] + u * sf->e1[k] + v * sf->e2[k];
+          // Newton on the values; Jets then take two steps that carry the
+          // derivatives
+          const Point3 xv = values(x);
+          const Projection ps = project_along(
+            slave_type, gdim, slave_values, xv, direction, sf->reference_centre);
+          const Projection pm = project_along(
+            master_type, gdim, master_values, xv, direction, mf.reference_centre);
+          if (!ps.converged or !pm.converged)
+          {
+            ++failed;
+            continue;
+          }
+          std::array<T, 2> Xs, Xm;
+          if constexpr (std::is_same_v<T, double>)
+          {
+            Xs = ps.X;
+            Xm = pm.X;
+          }
+          else
+          {
+            Xs = refine_projection<T>(slave_type, gdim, slave_nodes, x, sf->normal, ps)
+                   .first;
+            Xm = refine_projection<T>(master_type, gdim, master_nodes, x, sf->normal, pm)
+                   .first;
+          }
+          Vec3<T> xs, xm;
+          cell_geometry<T>(slave_type, gdim, slave_nodes,
+                           std::span<const T>(Xs.data(), tdim), Ns, dNs, xs, tangents);
+          cell_geometry<T>(master_type, gdim, master_nodes,
+                           std::span<const T>(Xm.data(), tdim), Nm, dNm, xm, tangents);
+          Vec3<T> n = { 0.0, 0.0, 0.0 };
+          for (int a = 0; a < ns; ++a)
+            for (int k = 0; k < gdim; ++k)
+              n[k] += Ns[a] * slave_normals[a * gdim + k];
+          // n interpolates unit vectors: its length is dimensionless and
+          // of order 1 unless the nodal normals cancel
+          const T n_norm = norm(n);
+          const bool n_defined = value(n_norm) > geometric_tolerance;
+          const Vec3<T> gap_vector = sub(xs, xm);
+          const T d = n_defined ? T(dot(gap_vector, n) / n_norm) : T(0.0);
+          T w = weights[q] * cell.measure;
+          // the surface of revolution's measure 2πr ds: r is the slave
+          // point's radius (clamped: a node on the axis may sit at −1e-17)
+          if (axisymmetric)
+            w = w * (2 * std::numbers::pi * larger(xs[0], T(0.0)));
+          on_point(SegmentPoint<T>{ w, Ns, Nm, d, n, n_norm, n_defined });
+        }
+    }
+  }
+  return failed;
+}
+
+} // namespace dolfinx_mortar
