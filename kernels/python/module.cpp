@@ -5,6 +5,7 @@
 #include <dolfinx_mortar/basis_coefficients.h>
 #include <dolfinx_mortar/basis_kind.h>
 #include <dolfinx_mortar/bounding_box_tree.h>
+#include <dolfinx_mortar/current_pair_gaps.h>
 #include <dolfinx_mortar/element_integrals.h>
 #include <dolfinx_mortar/facet_element.h>
 #include <dolfinx_mortar/geometric_tolerance.h>
@@ -26,6 +27,8 @@ namespace
 using array_t = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using int_array_t =
   py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>;
+using int64_array_t =
+  py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 
 template<typename T>
 py::array_t<T>
@@ -361,4 +364,87 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("keep_points") = false,
     py::arg("axisymmetric") = false,
     "Segmentation and slave-basis mortar integrals per cell pair");
+  m.def(
+    "current_pair_gaps",
+    [](FacetType slave_type,
+       const array_t& xs,
+       const int_array_t& cs,
+       const int64_array_t& slave_ids,
+       FacetType master_type,
+       const array_t& xm,
+       const int_array_t& cm,
+       const int64_array_t& master_ids,
+       const int_array_t& pairs,
+       const array_t& points,
+       const array_t& weights,
+       double zero,
+       bool opposing_normals_only)
+    {
+      auto slave = surface_view(slave_type, xs, cs);
+      auto master = surface_view(master_type, xm, cm);
+      PairGapDerivatives r;
+      {
+        py::gil_scoped_release release;
+        r = current_pair_gaps(
+          slave,
+          std::span<const std::int64_t>(slave_ids.data(), slave_ids.size()),
+          master,
+          std::span<const std::int64_t>(master_ids.data(), master_ids.size()),
+          std::span<const std::int32_t>(pairs.data(), pairs.size()),
+          as_span(points),
+          as_span(weights),
+          zero,
+          opposing_normals_only);
+      }
+      const auto np = static_cast<py::ssize_t>(pairs.size() / 2);
+      const py::ssize_t ns = cs.shape(1);
+      const py::ssize_t nv = static_cast<py::ssize_t>(r.num_nodes) * xs.shape(1);
+      py::dict out;
+      out["nodes"] = to_numpy_as<std::int64_t>(r.nodes, { np, r.num_nodes });
+      out["value"] = to_numpy(r.value, { np, ns });
+      out["gradient"] = to_numpy(r.gradient, { np, ns, nv });
+      out["hessian"] = to_numpy(r.hessian, { np, ns, nv, nv });
+      out["failed_projections"] = r.failed_projections;
+      return out;
+    },
+    py::arg("slave_type"),
+    py::arg("slave_x"),
+    py::arg("slave_cells"),
+    py::arg("slave_ids"),
+    py::arg("master_type"),
+    py::arg("master_x"),
+    py::arg("master_cells"),
+    py::arg("master_ids"),
+    py::arg("pairs"),
+    py::arg("points"),
+    py::arg("weights"),
+    py::arg("zero"),
+    py::arg("opposing_normals_only") = true,
+    "Current-configuration mortar gaps of cell pairs with exact gradients "
+    "and Hessians");
+
+  m.def(
+    "averaged_normal_derivatives",
+    [](FacetType type, const array_t& x, const int_array_t& cells,
+       const int64_array_t& ids, std::int64_t node)
+    {
+      auto s = surface_view(type, x, cells);
+      NormalDerivatives r = averaged_normal_derivatives(
+        s, std::span<const std::int64_t>(ids.data(), ids.size()), node);
+      const py::ssize_t gdim = x.shape(1);
+      const auto K = static_cast<py::ssize_t>(r.star.size()) * gdim;
+      py::dict out;
+      out["star"] = to_numpy_as<std::int64_t>(
+        r.star, { static_cast<py::ssize_t>(r.star.size()) });
+      out["value"] = py::array_t<double>({ gdim }, r.value.data());
+      out["gradient"] = to_numpy(r.gradient, { gdim, K });
+      out["hessian"] = to_numpy(r.hessian, { gdim, K, K });
+      return out;
+    },
+    py::arg("facet_type"),
+    py::arg("x"),
+    py::arg("cells"),
+    py::arg("ids"),
+    py::arg("node"),
+    "The averaged unit normal at a node with its exact derivatives");
 }

@@ -71,16 +71,6 @@ facet_geometry(const FacetSurface& s,
 }
 
 Point3
-size_weighted_normal(int gdim, const std::array<Point3, 2>& t)
-{
-  if (gdim == 2)
-    return { t[0][1], -t[0][0], 0 };
-  return { t[0][1] * t[1][2] - t[0][2] * t[1][1],
-           t[0][2] * t[1][0] - t[0][0] * t[1][2],
-           t[0][0] * t[1][1] - t[0][1] * t[1][0] };
-}
-
-Point3
 normal_from_tangents(int gdim, const std::array<Point3, 2>& t, double zero)
 {
   Point3 n = size_weighted_normal(gdim, t);

@@ -144,16 +144,18 @@ def test_current_configuration_reports_what_it_cannot_do():
     common = dict(E=1.0, nu=0.3, penalty=10.0, basis_configuration="current")
     with pytest.raises(NotImplementedError, match="GLS"):
         ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), kind="GLS", **common)
-    cube = mesh.create_unit_cube(MPI.COMM_WORLD, 1, 1, 1, cell_type=mesh.CellType.hexahedron)
-    faces = [mesh.locate_entities_boundary(cube, 2, lambda x, z=z: np.isclose(x[2], z))
-             for z in (0.0, 1.0)]
-    order = np.argsort(np.concatenate(faces))
-    cube_tags = mesh.meshtags(cube, 2, np.concatenate(faces)[order].astype(np.int32),
-                              np.concatenate([np.full(len(f), t, dtype=np.int32)
-                                              for f, t in zip(faces, (1, 2))])[order])
-    V3 = fem.VectorFunctionSpace(cube, ("Lagrange", 1))
-    with pytest.raises(NotImplementedError, match="P1 triangle facets only"):
-        ContactProblem(V3, cube_tags, 1, master_tag=2, kind="LcLS*", **common)
+    for cell_type, degree, message in ((mesh.CellType.hexahedron, 1, "P1 lines or triangles"),
+                                       (mesh.CellType.tetrahedron, 2, "quadratic facets")):
+        cube = mesh.create_unit_cube(MPI.COMM_WORLD, 1, 1, 1, cell_type=cell_type)
+        faces = [mesh.locate_entities_boundary(cube, 2, lambda x, z=z: np.isclose(x[2], z))
+                 for z in (0.0, 1.0)]
+        order = np.argsort(np.concatenate(faces))
+        cube_tags = mesh.meshtags(cube, 2, np.concatenate(faces)[order].astype(np.int32),
+                                  np.concatenate([np.full(len(f), t, dtype=np.int32)
+                                                  for f, t in zip(faces, (1, 2))])[order])
+        V3 = fem.VectorFunctionSpace(cube, ("Lagrange", degree))
+        with pytest.raises(NotImplementedError, match=message):
+            ContactProblem(V3, cube_tags, 1, master_tag=2, kind="LcLS*", **common)
     with pytest.raises(NotImplementedError, match="boundary modification"):
         ContactProblem(V, tags, 1, master_tag=2, kind="LcLS*", boundary_modification=True,
                        **common)

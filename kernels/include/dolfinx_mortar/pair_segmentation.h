@@ -102,6 +102,17 @@ cell_geometry(FacetType type,
   }
 }
 
+/// Normal from tangents with length |J| (2D: (t_y, -t_x), 3D: t0 × t1; only
+/// tangents[0] is used in 2D).
+template<typename T>
+Vec3<T>
+size_weighted_normal(int gdim, const std::array<Vec3<T>, 2>& t)
+{
+  if (gdim == 2)
+    return { t[0][1], -t[0][0], 0.0 };
+  return vec3::cross(t[0], t[1]);
+}
+
 /// A flat piece of a facet: its reference polygon's centre, its physical
 /// polygon, and the plane (line in 2D) through its centre.
 template<typename T>

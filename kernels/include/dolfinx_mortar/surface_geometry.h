@@ -43,11 +43,6 @@ facet_geometry(const FacetSurface& s,
                Point3& x,
                std::array<Point3, 2>& tangents);
 
-/// Normal from tangents with length |J| (2D: (t_y, -t_x), 3D: t0 × t1; only
-/// tangents[0] is used in 2D).
-Point3
-size_weighted_normal(int gdim, const std::array<Point3, 2>& tangents);
-
 /// Unit normal from tangents (2D: only tangents[0] is used), or the zero
 /// vector where the tangents span no plane: the tangent's length (2D) or the
 /// tangents' parallelogram height (3D) at most @p zero (zero_length()).

@@ -1,0 +1,75 @@
+// Copyright (C) 2026 dolfinx_mortar developers
+// SPDX-License-Identifier: MIT
+#pragma once
+
+#include "surface_geometry.h"
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace dolfinx_mortar
+{
+
+/// The mortar gaps c_A = ∫ N_A d of slave–master cell pairs in the current
+/// configuration, with their exact gradients and Hessians with respect to
+/// every node they depend on: the slave cell's, the master cell's, and
+/// those of the slave cells around each slave node (through the averaged
+/// nodal normals).
+struct PairGapDerivatives
+{
+  int num_nodes = 0; ///< variable nodes per pair (padded to the largest)
+  /// (pairs, num_nodes): global ids of the variable nodes, the slave cell's
+  /// first, then the rest of the slave nodes, then the master cell's; −1
+  /// pads
+  std::vector<std::int64_t> nodes;
+  std::vector<double> value;    ///< (pairs, ns)
+  std::vector<double> gradient; ///< (pairs, ns, num_nodes·gdim)
+  std::vector<double> hessian;  ///< (pairs, ns, num_nodes·gdim, num_nodes·gdim)
+  std::int64_t failed_projections = 0; ///< quadrature points skipped
+};
+
+/// The averaged unit normal at a surface node (the size-weighted normals of
+/// the cells around it, summed and normalized: element_node_normals) with
+/// its exact first and second derivatives.
+struct NormalDerivatives
+{
+  std::vector<std::int64_t> star; ///< ids of the nodes it depends on
+  std::array<double, 3> value{};  ///< unit normal (gdim used)
+  std::vector<double> gradient;   ///< (gdim, star·gdim)
+  std::vector<double> hessian;    ///< (gdim, star·gdim, star·gdim)
+};
+
+/// The averaged normal at node id @p node of a surface whose nodes carry
+/// the global ids @p ids (a gathered surface has one copy of a node per cell;
+/// copies share an id).
+/// @throws std::invalid_argument if no cell holds the node or the summed
+/// normal vanishes
+NormalDerivatives
+averaged_normal_derivatives(const FacetSurface& s,
+                            std::span<const std::int64_t> ids,
+                            std::int64_t node);
+
+/// c_A and its derivatives for every pair: integrate_pair instantiated with
+/// a Jet over the pair's slave nodes, nodal normals and master nodes, then
+/// chained through the normals to the nodes around the slave cell.
+///
+/// @param[in] slave, master The surfaces in the current configuration
+/// @param[in] slave_ids, master_ids Global id of every node
+/// @param[in] pairs (pairs, 2): slave cell, master cell
+/// @param[in] points, weights The segment rule (as mortar_integrals)
+/// @param[in] zero The zero length of the geometric decisions (the same as
+/// the values' segmentation used)
+/// @throws std::invalid_argument for element combinations without an
+/// instantiation (3D quadratic facets)
+PairGapDerivatives
+current_pair_gaps(const FacetSurface& slave,
+                  std::span<const std::int64_t> slave_ids,
+                  const FacetSurface& master,
+                  std::span<const std::int64_t> master_ids,
+                  std::span<const std::int32_t> pairs,
+                  std::span<const double> points,
+                  std::span<const double> weights,
+                  double zero,
+                  bool opposing_normals_only);
+
+} // namespace dolfinx_mortar

@@ -1,0 +1,483 @@
+// Copyright (C) 2026 dolfinx_mortar developers
+// SPDX-License-Identifier: MIT
+#include <dolfinx_mortar/current_pair_gaps.h>
+#include <dolfinx_mortar/pair_segmentation.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace dolfinx_mortar
+{
+namespace
+{
+/// The chain rule for f(y(z)) with f's gradient @p gf (m) and Hessian @p Hf
+/// (m × m) in y, y's Jacobian @p J (m × K) and the Hessians @p Hy of its
+/// entries (K × K each; null where y_i is linear in z):
+/// g = Jᵀ gf, H = Jᵀ Hf J + Σ_i gf_i Hy_i.
+void
+compose(int m,
+        int K,
+        std::span<const double> gf,
+        std::span<const double> Hf,
+        std::span<const double> J,
+        const std::vector<const double*>& Hy,
+        std::span<double> g,
+        std::span<double> H)
+{
+  std::fill(g.begin(), g.end(), 0.0);
+  std::fill(H.begin(), H.end(), 0.0);
+  std::vector<double> HJ(m * K, 0.0);
+  for (int i = 0; i < m; ++i)
+  {
+    for (int z = 0; z < K; ++z)
+      g[z] += gf[i] * J[i * K + z];
+    for (int j = 0; j < m; ++j)
+    {
+      const double hij = Hf[i * m + j];
+      for (int z = 0; z < K; ++z)
+        HJ[i * K + z] += hij * J[j * K + z];
+    }
+  }
+  for (int i = 0; i < m; ++i)
+    for (int a = 0; a < K; ++a)
+    {
+      const double Jia = J[i * K + a];
+      for (int b = 0; b < K; ++b)
+        H[a * K + b] += Jia * HJ[i * K + b];
+    }
+  for (int i = 0; i < m; ++i)
+    if (Hy[i])
+      for (int ab = 0; ab < K * K; ++ab)
+        H[ab] += gf[i] * Hy[i][ab];
+}
+
+/// Value, gradient and full Hessian of a Jet, into flat arrays.
+template<int N>
+void
+unpack(const Jet<N>& x, double& v, double* g, double* H)
+{
+  v = x.v;
+  std::copy(x.g.begin(), x.g.end(), g);
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j)
+      H[i * N + j] = x.hessian(i, j);
+}
+
+/// The size-weighted normal of a cell at its node @p position, with its
+/// derivatives with respect to the cell's M = nodes·gdim coordinates.
+template<int M>
+void
+cell_normal_jet(FacetType type,
+                int gdim,
+                std::span<const double> nodes,
+                int position,
+                double* value_out,
+                double* grad,
+                double* hess)
+{
+  const int nn = facet_num_nodes(type), tdim = facet_tdim(type);
+  std::vector<Jet<M>> x(M), N(nn), dN(tdim * nn);
+  for (int i = 0; i < M; ++i)
+    x[i] = Jet<M>::variable(nodes[i], i);
+  const std::vector<double> reference = facet_reference_nodes(type);
+  const std::array<Jet<M>, 2> X = {
+    reference[position * tdim], tdim == 2 ? reference[position * tdim + 1] : 0.0
+  };
+  Vec3<Jet<M>> p;
+  std::array<Vec3<Jet<M>>, 2> t;
+  cell_geometry<Jet<M>>(
+    type, gdim, x, std::span<const Jet<M>>(X.data(), tdim), N, dN, p, t);
+  const Vec3<Jet<M>> n = size_weighted_normal(gdim, t);
+  for (int k = 0; k < gdim; ++k)
+    unpack(n[k], value_out[k], grad + k * M, hess + k * M * M);
+}
+
+void
+cell_normal_derivatives(FacetType type,
+                        int gdim,
+                        std::span<const double> nodes,
+                        int position,
+                        double* v,
+                        double* g,
+                        double* h)
+{
+  switch (facet_num_nodes(type) * gdim)
+  {
+    case 4:
+      return cell_normal_jet<4>(type, gdim, nodes, position, v, g, h);
+    case 6:
+      return cell_normal_jet<6>(type, gdim, nodes, position, v, g, h);
+    case 9:
+      return cell_normal_jet<9>(type, gdim, nodes, position, v, g, h);
+    case 12:
+      return cell_normal_jet<12>(type, gdim, nodes, position, v, g, h);
+    case 18:
+      return cell_normal_jet<18>(type, gdim, nodes, position, v, g, h);
+    case 24:
+      return cell_normal_jet<24>(type, gdim, nodes, position, v, g, h);
+    case 27:
+      return cell_normal_jet<27>(type, gdim, nodes, position, v, g, h);
+  }
+  throw std::logic_error("no cell normal instantiation for " + to_string(type));
+}
+
+/// The cells (cell, position) holding each node id.
+using Adjacency =
+  std::unordered_map<std::int64_t, std::vector<std::pair<std::int32_t, int>>>;
+
+Adjacency
+node_cells(const FacetSurface& s, std::span<const std::int64_t> ids)
+{
+  const int nn = facet_num_nodes(s.type);
+  Adjacency around;
+  for (std::size_t c = 0; c < s.num_cells(); ++c)
+    for (int i = 0; i < nn; ++i)
+      around[ids[s.cells[c * nn + i]]].emplace_back(static_cast<std::int32_t>(c), i);
+  return around;
+}
+
+NormalDerivatives
+normal_derivatives(const FacetSurface& s,
+                   std::span<const std::int64_t> ids,
+                   const Adjacency& around,
+                   std::int64_t node)
+{
+  const auto it = around.find(node);
+  if (it == around.end())
+    throw std::invalid_argument("node " + std::to_string(node) +
+                                " is on no cell of the surface");
+  const int nn = facet_num_nodes(s.type), gdim = s.gdim, M = nn * gdim;
+  NormalDerivatives out;
+  std::unordered_map<std::int64_t, int> position;
+  for (const auto& [c, i] : it->second)
+    for (int j = 0; j < nn; ++j)
+    {
+      const std::int64_t id = ids[s.cells[c * nn + j]];
+      if (position.emplace(id, static_cast<int>(out.star.size())).second)
+        out.star.push_back(id);
+    }
+  const int K = static_cast<int>(out.star.size()) * gdim;
+  std::vector<double> sv(3, 0.0), ds(gdim * K, 0.0), d2s(gdim * K * K, 0.0);
+  std::vector<double> nodes(M), v(gdim), g(gdim * M), h(gdim * M * M);
+  std::vector<int> column(M);
+  double largest = 0; // the largest cell normal: a length (2D) or an area
+  for (const auto& [c, i] : it->second)
+  {
+    gather_cell_nodes(s, c, nodes);
+    cell_normal_derivatives(s.type, gdim, nodes, i, v.data(), g.data(), h.data());
+    for (int j = 0; j < nn; ++j)
+      for (int k = 0; k < gdim; ++k)
+        column[j * gdim + k] = position[ids[s.cells[c * nn + j]]] * gdim + k;
+    double length = 0;
+    for (int k = 0; k < gdim; ++k)
+    {
+      sv[k] += v[k];
+      length += v[k] * v[k];
+      for (int a = 0; a < M; ++a)
+      {
+        ds[k * K + column[a]] += g[k * M + a];
+        for (int b = 0; b < M; ++b)
+          d2s[(k * K + column[a]) * K + column[b]] += h[(k * M + a) * M + b];
+      }
+    }
+    largest = std::max(largest, std::sqrt(length));
+  }
+  // n = s/|s| as a Jet in s, then chained to the nodes
+  std::array<Jet<3>, 3> sj;
+  for (int k = 0; k < 3; ++k)
+    sj[k] = k < gdim ? Jet<3>::variable(sv[k], k) : Jet<3>(0.0);
+  const Jet<3> length = sqrt(sj[0] * sj[0] + sj[1] * sj[1] + sj[2] * sj[2]);
+  // cancelling normals (a folded surface): judged against the cells' own
+  // normals, a dimensionless ratio
+  if (!(length.v > geometric_tolerance * largest))
+    throw std::invalid_argument("the normals around surface node " +
+                                std::to_string(node) + " cancel");
+  out.gradient.assign(gdim * K, 0.0);
+  out.hessian.assign(gdim * K * K, 0.0);
+  std::vector<const double*> Hy(gdim);
+  for (int k = 0; k < gdim; ++k)
+    Hy[k] = d2s.data() + k * K * K;
+  for (int k = 0; k < gdim; ++k)
+  {
+    const Jet<3> nk = sj[k] / length;
+    out.value[k] = nk.v;
+    std::vector<double> Hf(gdim * gdim);
+    for (int a = 0; a < gdim; ++a)
+      for (int b = 0; b < gdim; ++b)
+        Hf[a * gdim + b] = nk.hessian(a, b);
+    compose(gdim,
+            K,
+            std::span<const double>(nk.g.data(), gdim),
+            Hf,
+            ds,
+            Hy,
+            std::span<double>(out.gradient.data() + k * K, K),
+            std::span<double>(out.hessian.data() + k * K * K, K * K));
+  }
+  return out;
+}
+
+/// c_A of one pair as Jets over its slave coordinates, nodal normals and
+/// master coordinates (in that order); returns failed projections.
+template<int N>
+std::int64_t
+inner_pair_derivatives(FacetType slave_type,
+                       FacetType master_type,
+                       int gdim,
+                       std::span<const double> slave_nodes,
+                       std::span<const double> normals,
+                       std::span<const double> master_nodes,
+                       std::span<const double> points,
+                       std::span<const double> weights,
+                       double zero,
+                       bool opposing_normals_only,
+                       std::span<double> value,
+                       std::span<double> grad,
+                       std::span<double> hess)
+{
+  using J = Jet<N>;
+  std::vector<J> s(slave_nodes.size()), n(normals.size()), m(master_nodes.size());
+  int v = 0;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    s[i] = J::variable(slave_nodes[i], v++);
+  for (std::size_t i = 0; i < n.size(); ++i)
+    n[i] = J::variable(normals[i], v++);
+  for (std::size_t i = 0; i < m.size(); ++i)
+    m[i] = J::variable(master_nodes[i], v++);
+  const int ns = facet_num_nodes(slave_type);
+  std::vector<J> c(ns, J(0.0));
+  const std::int64_t failed = integrate_pair<J>(
+    slave_type,
+    master_type,
+    gdim,
+    s,
+    n,
+    m,
+    points,
+    weights,
+    zero,
+    opposing_normals_only,
+    false,
+    [&](const SegmentPoint<J>& q)
+    {
+      const J wd = q.weight * q.gap;
+      for (int a = 0; a < ns; ++a)
+        c[a] += wd * q.slave_N[a];
+    });
+  for (int a = 0; a < ns; ++a)
+    unpack(c[a], value[a], grad.data() + a * N, hess.data() + a * N * N);
+  return failed;
+}
+
+using InnerFunction = std::int64_t (*)(FacetType,
+                                       FacetType,
+                                       int,
+                                       std::span<const double>,
+                                       std::span<const double>,
+                                       std::span<const double>,
+                                       std::span<const double>,
+                                       std::span<const double>,
+                                       double,
+                                       bool,
+                                       std::span<double>,
+                                       std::span<double>,
+                                       std::span<double>);
+
+/// The instantiation for N variables: 2D lines of degree 1 or 2 (12–18),
+/// 3D P1 triangles and Q1 quadrilaterals (27–36).
+InnerFunction
+inner_for(int N)
+{
+  switch (N)
+  {
+    case 12:
+      return &inner_pair_derivatives<12>;
+    case 14:
+      return &inner_pair_derivatives<14>;
+    case 16:
+      return &inner_pair_derivatives<16>;
+    case 18:
+      return &inner_pair_derivatives<18>;
+    case 27:
+      return &inner_pair_derivatives<27>;
+    case 30:
+      return &inner_pair_derivatives<30>;
+    case 33:
+      return &inner_pair_derivatives<33>;
+    case 36:
+      return &inner_pair_derivatives<36>;
+  }
+  return nullptr;
+}
+} // namespace
+
+NormalDerivatives
+averaged_normal_derivatives(const FacetSurface& s,
+                            std::span<const std::int64_t> ids,
+                            std::int64_t node)
+{
+  s.check();
+  if (ids.size() != s.x.size() / s.gdim)
+    throw std::invalid_argument("one id per surface node expected");
+  return normal_derivatives(s, ids, node_cells(s, ids), node);
+}
+
+PairGapDerivatives
+current_pair_gaps(const FacetSurface& slave,
+                  std::span<const std::int64_t> slave_ids,
+                  const FacetSurface& master,
+                  std::span<const std::int64_t> master_ids,
+                  std::span<const std::int32_t> pairs,
+                  std::span<const double> points,
+                  std::span<const double> weights,
+                  double zero,
+                  bool opposing_normals_only)
+{
+  slave.check();
+  master.check();
+  if (slave.gdim != master.gdim)
+    throw std::invalid_argument("slave and master surfaces differ in gdim");
+  const int gdim = slave.gdim;
+  if (slave_ids.size() != slave.x.size() / gdim or
+      master_ids.size() != master.x.size() / gdim)
+    throw std::invalid_argument("one id per surface node expected");
+  if (pairs.size() % 2 != 0)
+    throw std::invalid_argument("pairs must have shape (pairs, 2)");
+  if (points.size() != weights.size() * (gdim - 1))
+    throw std::invalid_argument("quadrature points must have shape (points, " +
+                                std::to_string(gdim - 1) + ")");
+  const int ns = facet_num_nodes(slave.type), nm = facet_num_nodes(master.type);
+  const int N = (2 * ns + nm) * gdim;
+  const InnerFunction inner = inner_for(N);
+  if (!inner)
+    throw std::invalid_argument(
+      "exact derivatives of the current-configuration mortar gap are "
+      "instantiated for lines and for P1 triangles and Q1 quadrilaterals, not "
+      "for " + to_string(slave.type) + " against " + to_string(master.type));
+
+  const Adjacency around = node_cells(slave, slave_ids);
+  std::unordered_map<std::int64_t, NormalDerivatives> normal_cache;
+  auto normal_of = [&](std::int64_t id) -> const NormalDerivatives&
+  {
+    auto it = normal_cache.find(id);
+    if (it == normal_cache.end())
+      it = normal_cache.emplace(id, normal_derivatives(slave, slave_ids, around, id))
+             .first;
+    return it->second;
+  };
+
+  struct PairResult
+  {
+    std::vector<std::int64_t> nodes;
+    std::vector<double> value, gradient, hessian;
+  };
+  const std::size_t P = pairs.size() / 2;
+  std::vector<PairResult> results(P);
+  PairGapDerivatives out;
+  std::vector<double> xs(ns * gdim), xm(nm * gdim), normals(ns * gdim);
+  std::vector<double> value(ns), grad(ns * N), hess(ns * N * N);
+  for (std::size_t p = 0; p < P; ++p)
+  {
+    const auto cs = static_cast<std::size_t>(pairs[2 * p]);
+    const auto cm = static_cast<std::size_t>(pairs[2 * p + 1]);
+    if (cs >= slave.num_cells() or cm >= master.num_cells())
+      throw std::invalid_argument("pair refers to a missing cell");
+    gather_cell_nodes(slave, cs, xs);
+    gather_cell_nodes(master, cm, xm);
+    PairResult& r = results[p];
+    std::unordered_map<std::int64_t, int> slave_position;
+    for (int a = 0; a < ns; ++a)
+    {
+      const std::int64_t id = slave_ids[slave.cells[cs * ns + a]];
+      const NormalDerivatives& nd = normal_of(id);
+      std::copy_n(nd.value.begin(), gdim, normals.begin() + a * gdim);
+      if (slave_position.emplace(id, static_cast<int>(r.nodes.size())).second)
+        r.nodes.push_back(id);
+    }
+    for (int a = 0; a < ns; ++a)
+      for (std::int64_t id : normal_of(slave_ids[slave.cells[cs * ns + a]]).star)
+        if (slave_position.emplace(id, static_cast<int>(r.nodes.size())).second)
+          r.nodes.push_back(id);
+    const int num_slave = static_cast<int>(r.nodes.size());
+    for (int c = 0; c < nm; ++c)
+      r.nodes.push_back(master_ids[master.cells[cm * nm + c]]);
+    const int K = static_cast<int>(r.nodes.size()) * gdim;
+
+    out.failed_projections += inner(slave.type, master.type, gdim, xs, normals, xm,
+                                    points, weights, zero, opposing_normals_only,
+                                    value, grad, hess);
+    // the inner variables as functions of the nodes: identity for the
+    // coordinates, the averaged normals' derivatives for the normals
+    std::vector<double> J(N * K, 0.0), normal_hessians(ns * gdim * K * K, 0.0);
+    std::vector<const double*> Hy(N, nullptr);
+    for (int a = 0; a < ns; ++a)
+    {
+      const std::int64_t id = slave_ids[slave.cells[cs * ns + a]];
+      const int own = slave_position[id];
+      const NormalDerivatives& nd = normal_of(id);
+      const int Ks = static_cast<int>(nd.star.size()) * gdim;
+      std::vector<int> column(Ks);
+      for (std::size_t j = 0; j < nd.star.size(); ++j)
+        for (int l = 0; l < gdim; ++l)
+          column[j * gdim + l] = slave_position[nd.star[j]] * gdim + l;
+      for (int k = 0; k < gdim; ++k)
+      {
+        J[(a * gdim + k) * K + own * gdim + k] = 1.0;
+        const int row = (ns + a) * gdim + k;
+        double* H = normal_hessians.data() + (a * gdim + k) * K * K;
+        for (int i = 0; i < Ks; ++i)
+        {
+          J[row * K + column[i]] += nd.gradient[k * Ks + i];
+          for (int j = 0; j < Ks; ++j)
+            H[column[i] * K + column[j]] += nd.hessian[(k * Ks + i) * Ks + j];
+        }
+        Hy[row] = H;
+      }
+    }
+    for (int c = 0; c < nm; ++c)
+      for (int k = 0; k < gdim; ++k)
+        J[((2 * ns + c) * gdim + k) * K + (num_slave + c) * gdim + k] = 1.0;
+
+    r.value = value;
+    r.gradient.resize(ns * K);
+    r.hessian.resize(ns * K * K);
+    for (int a = 0; a < ns; ++a)
+      compose(N, K,
+              std::span<const double>(grad.data() + a * N, N),
+              std::span<const double>(hess.data() + a * N * N, N * N),
+              J, Hy,
+              std::span<double>(r.gradient.data() + a * K, K),
+              std::span<double>(r.hessian.data() + a * K * K, K * K));
+  }
+
+  // pad every pair to the largest variable count
+  std::size_t width = 0;
+  for (const PairResult& r : results)
+    width = std::max(width, r.nodes.size());
+  out.num_nodes = static_cast<int>(width);
+  const std::size_t Kw = width * gdim;
+  out.nodes.assign(P * width, -1);
+  out.value.assign(P * ns, 0.0);
+  out.gradient.assign(P * ns * Kw, 0.0);
+  out.hessian.assign(P * ns * Kw * Kw, 0.0);
+  for (std::size_t p = 0; p < P; ++p)
+  {
+    const PairResult& r = results[p];
+    const std::size_t K = r.nodes.size() * gdim;
+    std::copy(r.nodes.begin(), r.nodes.end(), out.nodes.begin() + p * width);
+    std::copy(r.value.begin(), r.value.end(), out.value.begin() + p * ns);
+    for (int a = 0; a < ns; ++a)
+    {
+      std::copy_n(r.gradient.begin() + a * K, K,
+                  out.gradient.begin() + (p * ns + a) * Kw);
+      for (std::size_t i = 0; i < K; ++i)
+        std::copy_n(r.hessian.begin() + (a * K + i) * K, K,
+                    out.hessian.begin() + ((p * ns + a) * Kw + i) * Kw);
+    }
+  }
+  return out;
+}
+
+} // namespace dolfinx_mortar
