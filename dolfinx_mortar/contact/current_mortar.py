@@ -23,6 +23,7 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
+from dolfinx_mortar.contact.active_set import NEAR_CONTACT
 from dolfinx_mortar.contact.finite_deformation import CurrentSurfaceGap
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
@@ -78,8 +79,10 @@ class CurrentMortarGap(CurrentSurfaceGap):
         #: the kernel's coupling at the last evaluation (pairs, reference values)
         self.coupling: Optional[MortarCoupling] = None
 
-    def pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling) -> dict:
-        """``c_A = ∫ N_A d`` of every pair of ``coupling`` with exact derivatives.
+    def pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
+                         which: Optional[npt.NDArray[np.bool_]] = None) -> dict:
+        """``c_A = ∫ N_A d`` of the pairs of ``coupling`` (all, or those where
+        ``which`` is True) with exact derivatives.
 
         Returns the kernel's arrays: ``value`` (pairs, ns), ``gradient``
         (pairs, ns, nv), ``hessian`` (pairs, ns, nv, nv) and ``nodes`` (pairs,
@@ -89,8 +92,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
         slave = self.slave
         copy = gather_surface(slave, slave.x + u_nodes)
         master = coupling.master_copy
-        pairs = coupling.pairs.copy()
-        pairs[:, 0] += self._first_cell
+        pairs = coupling.pairs if which is None else coupling.pairs[which]
+        pairs = pairs + np.array([self._first_cell, 0])
         return _kernels.current_pair_gaps(
             slave.facet_type, copy.x, copy.cells, copy.global_ids.astype(np.int64),
             master.facet_type, master.x, master.cells, master.global_ids.astype(np.int64),
@@ -104,8 +107,14 @@ class CurrentMortarGap(CurrentSurfaceGap):
         coupling = MortarCoupling(slave.moved(u_nodes), self.master.moved(u_nodes),
                                   search_radius=self.search_radius)
         self.coupling = coupling
-        cells = slave.cells[coupling.pairs[:, 0]]
-        r = self.pair_derivatives(u_nodes, coupling)
+        all_cells = slave.cells[coupling.pairs[:, 0]]
+        # the values of every pair from the double kernel; derivatives only
+        # where a node may carry contact force or stiffness
+        g = layout.sum_at_functions(all_cells, coupling.raw_pairs[2] @ self.C)
+        near = self.near_contact(g, self._lumped_weights(e))
+        kept = np.any(near[all_cells], axis=1)
+        cells = all_cells[kept]
+        r = self.pair_derivatives(u_nodes, coupling, kept)
         nodes = r["nodes"]
         if nodes.shape[1] == 0:                 # no pair on this rank
             nodes = np.zeros((len(cells), 1), dtype=np.int64)
@@ -121,10 +130,22 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # to the weights instead, one small product instead of a large one)
         value = value @ self.C
         grad = np.einsum("pbn,ba->pan", grad, self.C)
-        g = layout.sum_at_functions(cells, value)
-        self.covered = layout.on_cells(cells)
+        self.covered = layout.on_cells(all_cells)
         G_g = assemble_blocks(layout, cells, self.dofs, dofs, grad)
-        return g, G_g, {"cells": cells, "dofs": dofs, "hess": hess, "value": value}
+        return g, G_g, {"cells": cells, "dofs": dofs, "hess": hess, "value": value,
+                        "pairs": np.flatnonzero(kept)}
+
+    def near_contact(self, g: FloatArray, W: FloatArray) -> npt.NDArray[np.bool_]:
+        """Nodes whose gap derivatives are needed: those that may get contact
+        force or stiffness (:func:`~dolfinx_mortar.contact.active_set.stiffened_nodes`:
+        y ≥ −NEAR_CONTACT·length), with a margin of 2, or whose mean gap ĝ/W
+        is within two element lengths of contact. The others' rows of ∂ĝ/∂u
+        may be incomplete: they are multiplied by zero in the residual and in
+        the Jacobian. Decided from the same ĝ on every rank."""
+        Wsafe = np.where(W > 0, W, 1.0)
+        length = Wsafe ** (1.0 / self.slave.tdim)
+        y = g * Wsafe ** (-self.k)
+        return (y >= -2 * NEAR_CONTACT * length) | (g / Wsafe >= -2 * length)
 
     def _gap_hessian(self, data: dict, Fg: FloatArray) -> PETSc.Mat:
         # Σ_a F_g,a ∂²ĝ_a = Σ_b (C F_g)_b ∂²c_b

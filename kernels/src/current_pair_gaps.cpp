@@ -13,14 +13,18 @@ namespace dolfinx_mortar
 namespace
 {
 /// The chain rule for f(y(z)) with f's gradient @p gf (m) and Hessian @p Hf
-/// (m × m) in y, y's Jacobian @p J (m × K) and the Hessians @p Hy of its
-/// entries (K × K each; null where y_i is linear in z):
-/// g = Jᵀ gf, H = Jᵀ Hf J + Σ_i gf_i Hy_i.
+/// (m × m) in y, where y_i is either the node coordinate z_{column[i]}
+/// (column[i] ≥ 0) or a function of z with gradient row i of @p J (m × K)
+/// and Hessian @p Hy[i] (K × K; null if zero):
+/// g = Jᵀ gf, H = Jᵀ Hf J + Σ_i gf_i Hy_i. The coordinate rows are unit
+/// rows of J, and are applied as such (a third of the dense product's cost
+/// on a 3D pair).
 void
 compose(int m,
         int K,
         std::span<const double> gf,
         std::span<const double> Hf,
+        std::span<const int> column,
         std::span<const double> J,
         const std::vector<const double*>& Hy,
         std::span<double> g,
@@ -28,29 +32,42 @@ compose(int m,
 {
   std::fill(g.begin(), g.end(), 0.0);
   std::fill(H.begin(), H.end(), 0.0);
-  std::vector<double> HJ(m * K, 0.0);
+  std::vector<double> HJ(K);
   for (int i = 0; i < m; ++i)
   {
-    for (int z = 0; z < K; ++z)
-      g[z] += gf[i] * J[i * K + z];
+    // row i of Hf J
+    std::fill(HJ.begin(), HJ.end(), 0.0);
     for (int j = 0; j < m; ++j)
     {
       const double hij = Hf[i * m + j];
-      for (int z = 0; z < K; ++z)
-        HJ[i * K + z] += hij * J[j * K + z];
+      if (column[j] >= 0)
+        HJ[column[j]] += hij;
+      else
+        for (int z = 0; z < K; ++z)
+          HJ[z] += hij * J[j * K + z];
     }
-  }
-  for (int i = 0; i < m; ++i)
-    for (int a = 0; a < K; ++a)
+    if (column[i] >= 0)
     {
-      const double Jia = J[i * K + a];
-      for (int b = 0; b < K; ++b)
-        H[a * K + b] += Jia * HJ[i * K + b];
+      g[column[i]] += gf[i];
+      double* row = H.data() + column[i] * K;
+      for (int z = 0; z < K; ++z)
+        row[z] += HJ[z];
     }
-  for (int i = 0; i < m; ++i)
+    else
+    {
+      for (int a = 0; a < K; ++a)
+      {
+        const double Jia = J[i * K + a];
+        g[a] += gf[i] * Jia;
+        double* row = H.data() + a * K;
+        for (int z = 0; z < K; ++z)
+          row[z] += Jia * HJ[z];
+      }
+    }
     if (Hy[i])
       for (int ab = 0; ab < K * K; ++ab)
         H[ab] += gf[i] * Hy[i][ab];
+  }
 }
 
 /// Value, gradient and full Hessian of a Jet, into flat arrays.
@@ -199,6 +216,7 @@ normal_derivatives(const FacetSurface& s,
   std::vector<const double*> Hy(gdim);
   for (int k = 0; k < gdim; ++k)
     Hy[k] = d2s.data() + k * K * K;
+  const std::vector<int> dense_rows(gdim, -1);
   for (int k = 0; k < gdim; ++k)
   {
     const Jet<3> nk = sj[k] / length;
@@ -211,6 +229,7 @@ normal_derivatives(const FacetSurface& s,
             K,
             std::span<const double>(nk.g.data(), gdim),
             Hf,
+            dense_rows,
             ds,
             Hy,
             std::span<double>(out.gradient.data() + k * K, K),
@@ -412,33 +431,34 @@ current_pair_gaps(const FacetSurface& slave,
     // coordinates, the averaged normals' derivatives for the normals
     std::vector<double> J(N * K, 0.0), normal_hessians(ns * gdim * K * K, 0.0);
     std::vector<const double*> Hy(N, nullptr);
+    std::vector<int> column(N, -1);
     for (int a = 0; a < ns; ++a)
     {
       const std::int64_t id = slave_ids[slave.cells[cs * ns + a]];
       const int own = slave_position[id];
       const NormalDerivatives& nd = normal_of(id);
       const int Ks = static_cast<int>(nd.star.size()) * gdim;
-      std::vector<int> column(Ks);
+      std::vector<int> star_column(Ks);
       for (std::size_t j = 0; j < nd.star.size(); ++j)
         for (int l = 0; l < gdim; ++l)
-          column[j * gdim + l] = slave_position[nd.star[j]] * gdim + l;
+          star_column[j * gdim + l] = slave_position[nd.star[j]] * gdim + l;
       for (int k = 0; k < gdim; ++k)
       {
-        J[(a * gdim + k) * K + own * gdim + k] = 1.0;
+        column[a * gdim + k] = own * gdim + k;
         const int row = (ns + a) * gdim + k;
         double* H = normal_hessians.data() + (a * gdim + k) * K * K;
         for (int i = 0; i < Ks; ++i)
         {
-          J[row * K + column[i]] += nd.gradient[k * Ks + i];
+          J[row * K + star_column[i]] += nd.gradient[k * Ks + i];
           for (int j = 0; j < Ks; ++j)
-            H[column[i] * K + column[j]] += nd.hessian[(k * Ks + i) * Ks + j];
+            H[star_column[i] * K + star_column[j]] += nd.hessian[(k * Ks + i) * Ks + j];
         }
         Hy[row] = H;
       }
     }
     for (int c = 0; c < nm; ++c)
       for (int k = 0; k < gdim; ++k)
-        J[((2 * ns + c) * gdim + k) * K + (num_slave + c) * gdim + k] = 1.0;
+        column[(2 * ns + c) * gdim + k] = (num_slave + c) * gdim + k;
 
     r.value = value;
     r.gradient.resize(ns * K);
@@ -447,7 +467,7 @@ current_pair_gaps(const FacetSurface& slave,
       compose(N, K,
               std::span<const double>(grad.data() + a * N, N),
               std::span<const double>(hess.data() + a * N * N, N * N),
-              J, Hy,
+              column, J, Hy,
               std::span<double>(r.gradient.data() + a * K, K),
               std::span<double>(r.hessian.data() + a * K * K, K * K));
   }

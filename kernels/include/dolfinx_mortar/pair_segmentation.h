@@ -236,7 +236,10 @@ refine_projection(FacetType type,
   std::array<T, 2> X = { start.X[0], start.X[1] };
   T t = start.t;
   std::vector<T> N(nn), dN(tdim * nn);
-  for (int step = 0; step < 2; ++step)
+  // On an affine cell the system is linear in (X, t): one step solves it
+  // exactly, derivatives of every order included.
+  const bool affine = type == FacetType::P1_line or type == FacetType::P1_triangle;
+  for (int step = 0; step < (affine ? 1 : 2); ++step)
   {
     Vec3<T> x;
     std::array<Vec3<T>, 2> tangents;
