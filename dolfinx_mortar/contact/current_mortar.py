@@ -80,9 +80,11 @@ class CurrentMortarGap(CurrentSurfaceGap):
         self.coupling: Optional[MortarCoupling] = None
 
     def pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
-                         which: Optional[npt.NDArray[np.bool_]] = None) -> dict:
+                         which: Optional[npt.NDArray[np.bool_]] = None,
+                         with_hessian: bool = True) -> dict:
         """``c_A = ∫ N_A d`` of the pairs of ``coupling`` (all, or those where
-        ``which`` is True) with exact derivatives.
+        ``which`` is True) with exact derivatives (the Hessians only with
+        ``with_hessian``).
 
         Returns the kernel's arrays: ``value`` (pairs, ns), ``gradient``
         (pairs, ns, nv), ``hessian`` (pairs, ns, nv, nv) and ``nodes`` (pairs,
@@ -98,7 +100,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
             slave.facet_type, copy.x, copy.cells, copy.global_ids.astype(np.int64),
             master.facet_type, master.x, master.cells, master.global_ids.astype(np.int64),
             pairs.astype(np.int32), self.segment_points, self.segment_weights,
-            coupling.zero_length)
+            coupling.zero_length, with_hessian=with_hessian)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
@@ -114,7 +116,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
         near = self.near_contact(g, self._lumped_weights(e))
         kept = np.any(near[all_cells], axis=1)
         cells = all_cells[kept]
-        r = self.pair_derivatives(u_nodes, coupling, kept)
+        # the residual needs gradients only; _gap_hessian asks for the Hessians
+        # when (and if) a Jacobian is assembled at this u
+        r = self.pair_derivatives(u_nodes, coupling, kept, with_hessian=False)
         nodes = r["nodes"]
         if nodes.shape[1] == 0:                 # no pair on this rank
             nodes = np.zeros((len(cells), 1), dtype=np.int64)
@@ -125,15 +129,14 @@ class CurrentMortarGap(CurrentSurfaceGap):
         ns = cells.shape[1]
         value = r["value"]
         grad = r["gradient"].reshape(len(cells), ns, nv)
-        hess = r["hessian"].reshape(len(cells), ns, nv, nv)
-        # φ_a = Σ_b N_b C_ba (the Hessians stay in N: _gap_hessian applies C
-        # to the weights instead, one small product instead of a large one)
+        # φ_a = Σ_b N_b C_ba
         value = value @ self.C
         grad = np.einsum("pbn,ba->pan", grad, self.C)
         self.covered = layout.on_cells(all_cells)
         G_g = assemble_blocks(layout, cells, self.dofs, dofs, grad)
-        return g, G_g, {"cells": cells, "dofs": dofs, "hess": hess, "value": value,
-                        "pairs": np.flatnonzero(kept)}
+        return g, G_g, {"cells": cells, "dofs": dofs, "value": value,
+                        "pairs": np.flatnonzero(kept), "u_nodes": u_nodes,
+                        "coupling": coupling, "kept": kept}
 
     def near_contact(self, g: FloatArray, W: FloatArray) -> npt.NDArray[np.bool_]:
         """Nodes whose gap derivatives are needed: those that may get contact
@@ -148,6 +151,12 @@ class CurrentMortarGap(CurrentSurfaceGap):
         return (y >= -2 * NEAR_CONTACT * length) | (g / Wsafe >= -2 * length)
 
     def _gap_hessian(self, data: dict, Fg: FloatArray) -> PETSc.Mat:
-        # Σ_a F_g,a ∂²ĝ_a = Σ_b (C F_g)_b ∂²c_b
-        blocks = np.einsum("pb,pbmn->pmn", Fg[data["cells"]] @ self.C.T, data["hess"])
+        r = self.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
+                                  with_hessian=True)
+        cells, dofs = data["cells"], data["dofs"]
+        nv = dofs.shape[1]
+        hess = r["hessian"].reshape(len(cells), cells.shape[1], nv, nv)
+        # Σ_a F_g,a ∂²ĝ_a = Σ_b (C F_g)_b ∂²c_b (C applied to the weights, a
+        # small product, instead of to the Hessians)
+        blocks = np.einsum("pb,pbmn->pmn", Fg[cells] @ self.C.T, hess)
         return assemble_global_blocks(self.dofs, data["dofs"], data["dofs"], blocks)

@@ -378,7 +378,8 @@ PYBIND11_MODULE(_kernels, m)
        const array_t& points,
        const array_t& weights,
        double zero,
-       bool opposing_normals_only)
+       bool opposing_normals_only,
+       bool with_hessian)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
@@ -394,7 +395,8 @@ PYBIND11_MODULE(_kernels, m)
           as_span(points),
           as_span(weights),
           zero,
-          opposing_normals_only);
+          opposing_normals_only,
+          with_hessian);
       }
       const auto np = static_cast<py::ssize_t>(pairs.size() / 2);
       const py::ssize_t ns = cs.shape(1);
@@ -403,7 +405,8 @@ PYBIND11_MODULE(_kernels, m)
       out["nodes"] = to_numpy_as<std::int64_t>(r.nodes, { np, r.num_nodes });
       out["value"] = to_numpy(r.value, { np, ns });
       out["gradient"] = to_numpy(r.gradient, { np, ns, nv });
-      out["hessian"] = to_numpy(r.hessian, { np, ns, nv, nv });
+      const py::ssize_t nh = with_hessian ? nv : 0;
+      out["hessian"] = to_numpy(r.hessian, { np, ns, nh, nh });
       out["failed_projections"] = r.failed_projections;
       return out;
     },
@@ -420,6 +423,7 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("weights"),
     py::arg("zero"),
     py::arg("opposing_normals_only") = true,
+    py::arg("with_hessian") = true,
     "Current-configuration mortar gaps of cell pairs with exact gradients "
     "and Hessians");
 

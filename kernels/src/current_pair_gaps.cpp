@@ -239,8 +239,9 @@ normal_derivatives(const FacetSurface& s,
 }
 
 /// c_A of one pair as Jets over its slave coordinates, nodal normals and
-/// master coordinates (in that order); returns failed projections.
-template<int N>
+/// master coordinates (in that order); returns failed projections. Order 1:
+/// no Hessian (@p hess untouched).
+template<int N, int Order>
 std::int64_t
 inner_pair_derivatives(FacetType slave_type,
                        FacetType master_type,
@@ -256,7 +257,7 @@ inner_pair_derivatives(FacetType slave_type,
                        std::span<double> grad,
                        std::span<double> hess)
 {
-  using J = Jet<N>;
+  using J = Jet<N, Order>;
   std::vector<J> s(slave_nodes.size()), n(normals.size()), m(master_nodes.size());
   int v = 0;
   for (std::size_t i = 0; i < s.size(); ++i)
@@ -286,7 +287,12 @@ inner_pair_derivatives(FacetType slave_type,
         c[a] += wd * q.slave_N[a];
     });
   for (int a = 0; a < ns; ++a)
-    unpack(c[a], value[a], grad.data() + a * N, hess.data() + a * N * N);
+  {
+    value[a] = c[a].v;
+    std::copy(c[a].g.begin(), c[a].g.end(), grad.data() + a * N);
+    if constexpr (Order == 2)
+      unpack(c[a], value[a], grad.data() + a * N, hess.data() + a * N * N);
+  }
   return failed;
 }
 
@@ -306,27 +312,28 @@ using InnerFunction = std::int64_t (*)(FacetType,
 
 /// The instantiation for N variables: 2D lines of degree 1 or 2 (12–18),
 /// 3D P1 triangles and Q1 quadrilaterals (27–36).
+template<int Order>
 InnerFunction
 inner_for(int N)
 {
   switch (N)
   {
     case 12:
-      return &inner_pair_derivatives<12>;
+      return &inner_pair_derivatives<12, Order>;
     case 14:
-      return &inner_pair_derivatives<14>;
+      return &inner_pair_derivatives<14, Order>;
     case 16:
-      return &inner_pair_derivatives<16>;
+      return &inner_pair_derivatives<16, Order>;
     case 18:
-      return &inner_pair_derivatives<18>;
+      return &inner_pair_derivatives<18, Order>;
     case 27:
-      return &inner_pair_derivatives<27>;
+      return &inner_pair_derivatives<27, Order>;
     case 30:
-      return &inner_pair_derivatives<30>;
+      return &inner_pair_derivatives<30, Order>;
     case 33:
-      return &inner_pair_derivatives<33>;
+      return &inner_pair_derivatives<33, Order>;
     case 36:
-      return &inner_pair_derivatives<36>;
+      return &inner_pair_derivatives<36, Order>;
   }
   return nullptr;
 }
@@ -352,7 +359,8 @@ current_pair_gaps(const FacetSurface& slave,
                   std::span<const double> points,
                   std::span<const double> weights,
                   double zero,
-                  bool opposing_normals_only)
+                  bool opposing_normals_only,
+                  bool with_hessian)
 {
   slave.check();
   master.check();
@@ -369,7 +377,7 @@ current_pair_gaps(const FacetSurface& slave,
                                 std::to_string(gdim - 1) + ")");
   const int ns = facet_num_nodes(slave.type), nm = facet_num_nodes(master.type);
   const int N = (2 * ns + nm) * gdim;
-  const InnerFunction inner = inner_for(N);
+  const InnerFunction inner = with_hessian ? inner_for<2>(N) : inner_for<1>(N);
   if (!inner)
     throw std::invalid_argument(
       "exact derivatives of the current-configuration mortar gap are "
@@ -396,7 +404,7 @@ current_pair_gaps(const FacetSurface& slave,
   std::vector<PairResult> results(P);
   PairGapDerivatives out;
   std::vector<double> xs(ns * gdim), xm(nm * gdim), normals(ns * gdim);
-  std::vector<double> value(ns), grad(ns * N), hess(ns * N * N);
+  std::vector<double> value(ns), grad(ns * N), hess(with_hessian ? ns * N * N : 0);
   for (std::size_t p = 0; p < P; ++p)
   {
     const auto cs = static_cast<std::size_t>(pairs[2 * p]);
@@ -462,6 +470,23 @@ current_pair_gaps(const FacetSurface& slave,
 
     r.value = value;
     r.gradient.resize(ns * K);
+    if (!with_hessian)
+    {
+      // g = Jᵀ gf
+      std::fill(r.gradient.begin(), r.gradient.end(), 0.0);
+      for (int a = 0; a < ns; ++a)
+        for (int i = 0; i < N; ++i)
+        {
+          const double gi = grad[a * N + i];
+          double* g = r.gradient.data() + a * K;
+          if (column[i] >= 0)
+            g[column[i]] += gi;
+          else
+            for (int z = 0; z < K; ++z)
+              g[z] += gi * J[i * K + z];
+        }
+      continue;
+    }
     r.hessian.resize(ns * K * K);
     for (int a = 0; a < ns; ++a)
       compose(N, K,
@@ -481,7 +506,7 @@ current_pair_gaps(const FacetSurface& slave,
   out.nodes.assign(P * width, -1);
   out.value.assign(P * ns, 0.0);
   out.gradient.assign(P * ns * Kw, 0.0);
-  out.hessian.assign(P * ns * Kw * Kw, 0.0);
+  out.hessian.assign(with_hessian ? P * ns * Kw * Kw : 0, 0.0);
   for (std::size_t p = 0; p < P; ++p)
   {
     const PairResult& r = results[p];
@@ -492,6 +517,8 @@ current_pair_gaps(const FacetSurface& slave,
     {
       std::copy_n(r.gradient.begin() + a * K, K,
                   out.gradient.begin() + (p * ns + a) * Kw);
+      if (!with_hessian)
+        continue;
       for (std::size_t i = 0; i < K; ++i)
         std::copy_n(r.hessian.begin() + (a * K + i) * K, K,
                     out.hessian.begin() + ((p * ns + a) * Kw + i) * Kw);

@@ -87,10 +87,10 @@ def test_missing_the_normal_linearization_is_detected():
     # the same direction both times (fixed seeds): only the normals' terms differ
     exact_error = energy_gradient_error(problem)
 
-    def frozen_normals(u_nodes, coupling, which=None):
+    def frozen_normals(u_nodes, coupling, which=None, with_hessian=True):
         """Neighbour nodes held at their values: the normals lose part of their
         derivatives (the slave cell's own and the master's nodes keep theirs)."""
-        r = dict(exact(u_nodes, coupling, which))
+        r = dict(exact(u_nodes, coupling, which, with_hessian))
         ns, nm, gdim = model.slave.cells.shape[1], 2, 2
         nodes = r["nodes"]
         neighbour = np.zeros(nodes.shape, dtype=bool)

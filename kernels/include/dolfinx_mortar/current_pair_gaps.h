@@ -59,6 +59,8 @@ averaged_normal_derivatives(const FacetSurface& s,
 /// @param[in] points, weights The segment rule (as mortar_integrals)
 /// @param[in] zero The zero length of the geometric decisions (the same as
 /// the values' segmentation used)
+/// @param[in] with_hessian Also the Hessians (else `hessian` is empty and
+/// the gradients cost a fraction: a residual needs no Hessian)
 /// @throws std::invalid_argument for element combinations without an
 /// instantiation (3D quadratic facets)
 PairGapDerivatives
@@ -70,6 +72,7 @@ current_pair_gaps(const FacetSurface& slave,
                   std::span<const double> points,
                   std::span<const double> weights,
                   double zero,
-                  bool opposing_normals_only);
+                  bool opposing_normals_only,
+                  bool with_hessian = true);
 
 } // namespace dolfinx_mortar

@@ -8,19 +8,21 @@
 namespace dolfinx_mortar
 {
 
-/// A scalar with its exact gradient and Hessian with respect to N variables
-/// (second-order forward mode), so that one templated algorithm gives values
-/// (instantiated for double) and exact derivatives (for Jet).
+/// A scalar with its exact gradient and (Order 2) Hessian with respect to N
+/// variables (forward mode), so that one templated algorithm gives values
+/// (instantiated for double) and exact derivatives (for Jet). Order 1 carries
+/// the gradient alone, for evaluations that need no Hessian.
 ///
 /// Written here because the fixed stack has no second-order automatic
 /// differentiation: Eigen's AutoDiffScalar carries first derivatives, and
 /// nesting it for the Hessian allocates a dynamic vector per operation.
 /// The Hessian is stored as its upper triangle, row by row.
-template<int N>
+template<int N, int Order = 2>
 struct Jet
 {
+  static_assert(Order == 1 or Order == 2);
   static constexpr int size = N;
-  static constexpr int packed = N * (N + 1) / 2;
+  static constexpr int packed = Order == 2 ? N * (N + 1) / 2 : 0;
 
   double v = 0;                    ///< value
   std::array<double, N> g{};       ///< gradient
@@ -62,12 +64,15 @@ struct Jet
     y.constant = false;
     for (int i = 0; i < N; ++i)
       y.g[i] = d1 * g[i];
-    int k = 0;
-    for (int i = 0; i < N; ++i)
+    if constexpr (Order == 2)
     {
-      const double gi = d2 * g[i];
-      for (int j = i; j < N; ++j, ++k)
-        y.h[k] = d1 * h[k] + gi * g[j];
+      int k = 0;
+      for (int i = 0; i < N; ++i)
+      {
+        const double gi = d2 * g[i];
+        for (int j = i; j < N; ++j, ++k)
+          y.h[k] = d1 * h[k] + gi * g[j];
+      }
     }
     return y;
   }
@@ -148,12 +153,15 @@ struct Jet
     y.constant = false;
     for (int i = 0; i < N; ++i)
       y.g[i] = a.v * b.g[i] + b.v * a.g[i];
-    int k = 0;
-    for (int i = 0; i < N; ++i)
+    if constexpr (Order == 2)
     {
-      const double ai = a.g[i], bi = b.g[i];
-      for (int j = i; j < N; ++j, ++k)
-        y.h[k] = a.v * b.h[k] + b.v * a.h[k] + ai * b.g[j] + bi * a.g[j];
+      int k = 0;
+      for (int i = 0; i < N; ++i)
+      {
+        const double ai = a.g[i], bi = b.g[i];
+        for (int j = i; j < N; ++j, ++k)
+          y.h[k] = a.v * b.h[k] + b.v * a.h[k] + ai * b.g[j] + bi * a.g[j];
+      }
     }
     return y;
   }
@@ -183,9 +191,9 @@ value(double x)
 {
   return x;
 }
-template<int N>
+template<int N, int Order>
 double
-value(const Jet<N>& x)
+value(const Jet<N, Order>& x)
 {
   return x.v;
 }
