@@ -145,3 +145,26 @@ def test_hertz_axisymmetric_quadratic_elements_with_a_vertex_on_the_axis():
     curved facet and p0 came out +13.8%."""
     figures = load_demo("hertz_axisymmetric").main(["--degree", "2", "--refine", "0.5"])
     assert abs(figures["p0_error"]) < 5e-3 and abs(figures["a_error"]) < 5e-3
+
+
+def test_ironing2d_is_path_independent_and_converges(out):
+    """The stiff die pressed 1.4 into the slab, slid 4.0 and back (coarse: h = 0.5,
+    8 slide steps each way). Frictionless and elastic, the state back at the start
+    is the pressed state to the Newton tolerance; the drive needs no mean
+    tangential force while it slides."""
+    csv_path, png_path = out / "ironing2d.csv", out / "ironing2d.png"
+    figures = load_demo("ironing2d").main(
+        ["--h", "0.5", "--press-steps", "5", "--slide-steps", "8", "--return-slide",
+         "--quiet", "--csv", str(csv_path), "--png", str(png_path)])
+    steps = figures["steps"]
+    assert steps[-1]["t"] == 1.0 and steps[-1]["phase"] == "return"
+    assert steps[-1]["slide"] == pytest.approx(0.0, abs=1e-12)
+    assert figures["return_difference"] < 1e-8, figures["return_difference"]
+    assert figures["normal_mean"] > 0
+    assert abs(figures["tangential_mean"]) < 2e-2
+    pressed = [r for r in steps if r["phase"] == "press"][-1]
+    back = steps[-1]
+    assert back["normal_reaction"] == pytest.approx(pressed["normal_reaction"], rel=1e-8)
+    if MPI.COMM_WORLD.rank == 0:
+        assert len(csv_path.read_text().splitlines()) == len(steps) + 1
+        assert png_path.stat().st_size > 10_000
