@@ -400,7 +400,8 @@ PYBIND11_MODULE(_kernels, m)
       }
       const auto np = static_cast<py::ssize_t>(pairs.size() / 2);
       const py::ssize_t ns = cs.shape(1);
-      const py::ssize_t nv = static_cast<py::ssize_t>(r.num_nodes) * xs.shape(1);
+      const py::ssize_t nv =
+        static_cast<py::ssize_t>(r.num_nodes) * xs.shape(1);
       py::dict out;
       out["nodes"] = to_numpy_as<std::int64_t>(r.nodes, { np, r.num_nodes });
       out["value"] = to_numpy(r.value, { np, ns });
@@ -429,8 +430,11 @@ PYBIND11_MODULE(_kernels, m)
 
   m.def(
     "averaged_normal_derivatives",
-    [](FacetType type, const array_t& x, const int_array_t& cells,
-       const int64_array_t& ids, std::int64_t node)
+    [](FacetType type,
+       const array_t& x,
+       const int_array_t& cells,
+       const int64_array_t& ids,
+       std::int64_t node)
     {
       auto s = surface_view(type, x, cells);
       NormalDerivatives r = averaged_normal_derivatives(

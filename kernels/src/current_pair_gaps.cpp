@@ -99,9 +99,9 @@ cell_normal_jet(FacetType type,
   for (int i = 0; i < M; ++i)
     x[i] = Jet<M>::variable(nodes[i], i);
   const std::vector<double> reference = facet_reference_nodes(type);
-  const std::array<Jet<M>, 2> X = {
-    reference[position * tdim], tdim == 2 ? reference[position * tdim + 1] : 0.0
-  };
+  const std::array<Jet<M>, 2> X = { reference[position * tdim],
+                                    tdim == 2 ? reference[position * tdim + 1]
+                                              : 0.0 };
   Vec3<Jet<M>> p;
   std::array<Vec3<Jet<M>>, 2> t;
   cell_geometry<Jet<M>>(
@@ -151,7 +151,8 @@ node_cells(const FacetSurface& s, std::span<const std::int64_t> ids)
   Adjacency around;
   for (std::size_t c = 0; c < s.num_cells(); ++c)
     for (int i = 0; i < nn; ++i)
-      around[ids[s.cells[c * nn + i]]].emplace_back(static_cast<std::int32_t>(c), i);
+      around[ids[s.cells[c * nn + i]]].emplace_back(
+        static_cast<std::int32_t>(c), i);
   return around;
 }
 
@@ -183,7 +184,8 @@ normal_derivatives(const FacetSurface& s,
   for (const auto& [c, i] : it->second)
   {
     gather_cell_nodes(s, c, nodes);
-    cell_normal_derivatives(s.type, gdim, nodes, i, v.data(), g.data(), h.data());
+    cell_normal_derivatives(
+      s.type, gdim, nodes, i, v.data(), g.data(), h.data());
     for (int j = 0; j < nn; ++j)
       for (int k = 0; k < gdim; ++k)
         column[j * gdim + k] = position[ids[s.cells[c * nn + j]]] * gdim + k;
@@ -258,7 +260,8 @@ inner_pair_derivatives(FacetType slave_type,
                        std::span<double> hess)
 {
   using J = Jet<N, Order>;
-  std::vector<J> s(slave_nodes.size()), n(normals.size()), m(master_nodes.size());
+  std::vector<J> s(slave_nodes.size()), n(normals.size()),
+    m(master_nodes.size());
   int v = 0;
   for (std::size_t i = 0; i < s.size(); ++i)
     s[i] = J::variable(slave_nodes[i], v++);
@@ -268,24 +271,23 @@ inner_pair_derivatives(FacetType slave_type,
     m[i] = J::variable(master_nodes[i], v++);
   const int ns = facet_num_nodes(slave_type);
   std::vector<J> c(ns, J(0.0));
-  const std::int64_t failed = integrate_pair<J>(
-    slave_type,
-    master_type,
-    gdim,
-    s,
-    n,
-    m,
-    points,
-    weights,
-    zero,
-    opposing_normals_only,
-    false,
-    [&](const SegmentPoint<J>& q)
-    {
-      const J wd = q.weight * q.gap;
-      for (int a = 0; a < ns; ++a)
-        c[a] += wd * q.slave_N[a];
-    });
+  const std::int64_t failed = integrate_pair<J>(slave_type,
+                                                master_type,
+                                                gdim,
+                                                s,
+                                                n,
+                                                m,
+                                                points,
+                                                weights,
+                                                zero,
+                                                opposing_normals_only,
+                                                false,
+                                                [&](const SegmentPoint<J>& q)
+                                                {
+                                                  const J wd = q.weight * q.gap;
+                                                  for (int a = 0; a < ns; ++a)
+                                                    c[a] += wd * q.slave_N[a];
+                                                });
   for (int a = 0; a < ns; ++a)
   {
     value[a] = c[a].v;
@@ -382,7 +384,8 @@ current_pair_gaps(const FacetSurface& slave,
     throw std::invalid_argument(
       "exact derivatives of the current-configuration mortar gap are "
       "instantiated for lines and for P1 triangles and Q1 quadrilaterals, not "
-      "for " + to_string(slave.type) + " against " + to_string(master.type));
+      "for " +
+      to_string(slave.type) + " against " + to_string(master.type));
 
   const Adjacency around = node_cells(slave, slave_ids);
   std::unordered_map<std::int64_t, NormalDerivatives> normal_cache;
@@ -390,7 +393,8 @@ current_pair_gaps(const FacetSurface& slave,
   {
     auto it = normal_cache.find(id);
     if (it == normal_cache.end())
-      it = normal_cache.emplace(id, normal_derivatives(slave, slave_ids, around, id))
+      it = normal_cache
+             .emplace(id, normal_derivatives(slave, slave_ids, around, id))
              .first;
     return it->second;
   };
@@ -404,7 +408,8 @@ current_pair_gaps(const FacetSurface& slave,
   std::vector<PairResult> results(P);
   PairGapDerivatives out;
   std::vector<double> xs(ns * gdim), xm(nm * gdim), normals(ns * gdim);
-  std::vector<double> value(ns), grad(ns * N), hess(with_hessian ? ns * N * N : 0);
+  std::vector<double> value(ns), grad(ns * N),
+    hess(with_hessian ? ns * N * N : 0);
   for (std::size_t p = 0; p < P; ++p)
   {
     const auto cs = static_cast<std::size_t>(pairs[2 * p]);
@@ -424,7 +429,8 @@ current_pair_gaps(const FacetSurface& slave,
         r.nodes.push_back(id);
     }
     for (int a = 0; a < ns; ++a)
-      for (std::int64_t id : normal_of(slave_ids[slave.cells[cs * ns + a]]).star)
+      for (std::int64_t id :
+           normal_of(slave_ids[slave.cells[cs * ns + a]]).star)
         if (slave_position.emplace(id, static_cast<int>(r.nodes.size())).second)
           r.nodes.push_back(id);
     const int num_slave = static_cast<int>(r.nodes.size());
@@ -432,9 +438,19 @@ current_pair_gaps(const FacetSurface& slave,
       r.nodes.push_back(master_ids[master.cells[cm * nm + c]]);
     const int K = static_cast<int>(r.nodes.size()) * gdim;
 
-    out.failed_projections += inner(slave.type, master.type, gdim, xs, normals, xm,
-                                    points, weights, zero, opposing_normals_only,
-                                    value, grad, hess);
+    out.failed_projections += inner(slave.type,
+                                    master.type,
+                                    gdim,
+                                    xs,
+                                    normals,
+                                    xm,
+                                    points,
+                                    weights,
+                                    zero,
+                                    opposing_normals_only,
+                                    value,
+                                    grad,
+                                    hess);
     // the inner variables as functions of the nodes: identity for the
     // coordinates, the averaged normals' derivatives for the normals
     std::vector<double> J(N * K, 0.0), normal_hessians(ns * gdim * K * K, 0.0);
@@ -459,7 +475,8 @@ current_pair_gaps(const FacetSurface& slave,
         {
           J[row * K + star_column[i]] += nd.gradient[k * Ks + i];
           for (int j = 0; j < Ks; ++j)
-            H[star_column[i] * K + star_column[j]] += nd.hessian[(k * Ks + i) * Ks + j];
+            H[star_column[i] * K + star_column[j]] +=
+              nd.hessian[(k * Ks + i) * Ks + j];
         }
         Hy[row] = H;
       }
@@ -489,10 +506,13 @@ current_pair_gaps(const FacetSurface& slave,
     }
     r.hessian.resize(ns * K * K);
     for (int a = 0; a < ns; ++a)
-      compose(N, K,
+      compose(N,
+              K,
               std::span<const double>(grad.data() + a * N, N),
               std::span<const double>(hess.data() + a * N * N, N * N),
-              column, J, Hy,
+              column,
+              J,
+              Hy,
               std::span<double>(r.gradient.data() + a * K, K),
               std::span<double>(r.hessian.data() + a * K * K, K * K));
   }
@@ -515,12 +535,14 @@ current_pair_gaps(const FacetSurface& slave,
     std::copy(r.value.begin(), r.value.end(), out.value.begin() + p * ns);
     for (int a = 0; a < ns; ++a)
     {
-      std::copy_n(r.gradient.begin() + a * K, K,
+      std::copy_n(r.gradient.begin() + a * K,
+                  K,
                   out.gradient.begin() + (p * ns + a) * Kw);
       if (!with_hessian)
         continue;
       for (std::size_t i = 0; i < K; ++i)
-        std::copy_n(r.hessian.begin() + (a * K + i) * K, K,
+        std::copy_n(r.hessian.begin() + (a * K + i) * K,
+                    K,
                     out.hessian.begin() + ((p * ns + a) * Kw + i) * Kw);
     }
   }

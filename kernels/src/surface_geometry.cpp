@@ -20,7 +20,8 @@ gather_cell_nodes(const FacetSurface& s, std::size_t c, std::span<double> out)
   const int nn = facet_num_nodes(s.type);
   const std::int32_t* nodes = s.cells.data() + c * nn;
   for (int i = 0; i < nn; ++i)
-    std::copy_n(s.x.data() + nodes[i] * s.gdim, s.gdim, out.data() + i * s.gdim);
+    std::copy_n(
+      s.x.data() + nodes[i] * s.gdim, s.gdim, out.data() + i * s.gdim);
 }
 
 void
@@ -65,9 +66,14 @@ facet_geometry(const FacetSurface& s,
   std::array<double, 27> nodes; // at most 9 nodes × 3
   const int nn = facet_num_nodes(s.type);
   gather_cell_nodes(s, c, nodes);
-  cell_geometry<double>(s.type, s.gdim,
+  cell_geometry<double>(s.type,
+                        s.gdim,
                         std::span<const double>(nodes.data(), nn * s.gdim),
-                        X, N, dN, x, tangents);
+                        X,
+                        N,
+                        dN,
+                        x,
+                        tangents);
 }
 
 Point3

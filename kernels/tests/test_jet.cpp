@@ -46,7 +46,9 @@ TEST(Jet, ClippingTakesTheDoubleBranchesAndCarriesTheArea)
   // A triangle clipped by a square: the Jet area equals the double one, and
   // its gradient moves with a clip vertex as the area does
   const std::vector<Point2> tri = { { 0, 0 }, { 1, 0 }, { 0.2, 1 } };
-  const std::vector<Point2> sq = { { 0.1, -1 }, { 0.8, -1 }, { 0.8, 0.6 }, { 0.1, 0.6 } };
+  const std::vector<Point2> sq = {
+    { 0.1, -1 }, { 0.8, -1 }, { 0.8, 0.6 }, { 0.1, 0.6 }
+  };
   using J = Jet<16>;
   std::vector<std::array<J, 2>> tj, sj;
   int n = 0;

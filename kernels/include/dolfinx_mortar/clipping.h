@@ -98,7 +98,8 @@ clip_polygon(const std::vector<std::array<T, 2>>& subject,
   for (const P& p : output)
     if (merged.empty() or distance(p, merged.back()) > tolerance)
       merged.push_back(p);
-  while (merged.size() > 1 and distance(merged.front(), merged.back()) <= tolerance)
+  while (merged.size() > 1 and
+         distance(merged.front(), merged.back()) <= tolerance)
     merged.pop_back();
   return merged;
 }

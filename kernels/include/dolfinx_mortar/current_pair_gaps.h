@@ -24,7 +24,7 @@ struct PairGapDerivatives
   std::vector<std::int64_t> nodes;
   std::vector<double> value;    ///< (pairs, ns)
   std::vector<double> gradient; ///< (pairs, ns, num_nodes·gdim)
-  std::vector<double> hessian;  ///< (pairs, ns, num_nodes·gdim, num_nodes·gdim)
+  std::vector<double> hessian; ///< (pairs, ns, num_nodes·gdim, num_nodes·gdim)
   std::int64_t failed_projections = 0; ///< quadrature points skipped
 };
 

@@ -3,9 +3,9 @@
 #pragma once
 
 #include <array>
-#include <stdexcept>
 #include <cstddef>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 

@@ -24,9 +24,9 @@ struct Jet
   static constexpr int size = N;
   static constexpr int packed = Order == 2 ? N * (N + 1) / 2 : 0;
 
-  double v = 0;                    ///< value
-  std::array<double, N> g{};       ///< gradient
-  std::array<double, packed> h{};  ///< Hessian, upper triangle row-major
+  double v = 0;                   ///< value
+  std::array<double, N> g{};      ///< gradient
+  std::array<double, packed> h{}; ///< Hessian, upper triangle row-major
   /// Known to have zero derivatives (built from a double): products and
   /// sums with it skip the derivative arrays. Shape functions of affine
   /// cells and reference points make many such operands; skipping them

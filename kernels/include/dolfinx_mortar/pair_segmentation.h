@@ -167,8 +167,14 @@ make_subfacet(FacetType type,
   {
     const std::array<T, 2> XT = { X[0], X[1] };
     Vec3<T> x;
-    cell_geometry<T>(
-      type, gdim, nodes, std::span<const T>(XT.data(), tdim), N, dN, x, tangents);
+    cell_geometry<T>(type,
+                     gdim,
+                     nodes,
+                     std::span<const T>(XT.data(), tdim),
+                     N,
+                     dN,
+                     x,
+                     tangents);
     f.polygon.push_back(x);
     for (int k = 0; k < 3; ++k)
       f.centre[k] += x[k] / static_cast<double>(reference.size());
@@ -213,7 +219,8 @@ make_subfacet(FacetType type,
   // so positive after the height test
   std::vector<std::array<T, 2>> flat;
   for (const Vec3<T>& p : P)
-    flat.push_back({ dot(sub(p, f.centre), f.e1), dot(sub(p, f.centre), f.e2) });
+    flat.push_back(
+      { dot(sub(p, f.centre), f.e1), dot(sub(p, f.centre), f.e2) });
   f.size = absolute(signed_area(flat));
   return f;
 }
@@ -238,13 +245,20 @@ refine_projection(FacetType type,
   std::vector<T> N(nn), dN(tdim * nn);
   // On an affine cell the system is linear in (X, t): one step solves it
   // exactly, derivatives of every order included.
-  const bool affine = type == FacetType::P1_line or type == FacetType::P1_triangle;
+  const bool affine =
+    type == FacetType::P1_line or type == FacetType::P1_triangle;
   for (int step = 0; step < (affine ? 1 : 2); ++step)
   {
     Vec3<T> x;
     std::array<Vec3<T>, 2> tangents;
-    cell_geometry<T>(
-      type, gdim, nodes, std::span<const T>(X.data(), tdim), N, dN, x, tangents);
+    cell_geometry<T>(type,
+                     gdim,
+                     nodes,
+                     std::span<const T>(X.data(), tdim),
+                     N,
+                     dN,
+                     x,
+                     tangents);
     Vec3<T> F;
     for (int k = 0; k < gdim; ++k)
       F[k] = x[k] - p[k] - t * direction[k];
@@ -277,13 +291,13 @@ refine_projection(FacetType type,
 template<typename T>
 struct SegmentPoint
 {
-  T weight;                  ///< quadrature weight × measure
+  T weight;                    ///< quadrature weight × measure
   std::span<const T> slave_N;  ///< N_A at the slave point
   std::span<const T> master_N; ///< N^m_C at the master point
-  T gap;                     ///< d = (x_s − x_m)·n/|n|
-  Vec3<T> normal;            ///< interpolated nodal normal n (not unit)
-  T normal_norm;             ///< |n|
-  bool normal_defined;       ///< |n| above the geometric tolerance
+  T gap;                       ///< d = (x_s − x_m)·n/|n|
+  Vec3<T> normal;              ///< interpolated nodal normal n (not unit)
+  T normal_norm;               ///< |n|
+  bool normal_defined;         ///< |n| above the geometric tolerance
 };
 
 /// Segment one slave–master cell pair and call @p on_point at every
@@ -317,9 +331,13 @@ integrate_pair(FacetType slave_type,
   const std::size_t nq = weights.size();
   std::vector<double> slave_values(slave_nodes.size()),
     master_values(master_nodes.size());
-  std::transform(slave_nodes.begin(), slave_nodes.end(), slave_values.begin(),
+  std::transform(slave_nodes.begin(),
+                 slave_nodes.end(),
+                 slave_values.begin(),
                  [](const T& v) { return value(v); });
-  std::transform(master_nodes.begin(), master_nodes.end(), master_values.begin(),
+  std::transform(master_nodes.begin(),
+                 master_nodes.end(),
+                 master_values.begin(),
                  [](const T& v) { return value(v); });
   std::vector<T> Ns(ns), dNs(tdim * ns), Nm(nm), dNm(tdim * nm);
   std::array<Vec3<T>, 2> tangents;
@@ -331,7 +349,8 @@ integrate_pair(FacetType slave_type,
   std::int64_t failed = 0;
   for (const auto& piece : facet_subfacets(slave_type))
   {
-    const auto sf = make_subfacet<T>(slave_type, gdim, slave_nodes, piece, zero);
+    const auto sf =
+      make_subfacet<T>(slave_type, gdim, slave_nodes, piece, zero);
     if (!sf)
       continue;
     auto plane_coords = [&](const Vec3<T>& x) -> P2
@@ -363,13 +382,16 @@ integrate_pair(FacetType slave_type,
       std::vector<Cell> cells;
       if (gdim == 2)
       {
-        const T lo = larger(slave_polygon[0][0],
-                            smaller(master_polygon[0][0], master_polygon[1][0]));
-        const T hi = smaller(slave_polygon[1][0],
-                             larger(master_polygon[0][0], master_polygon[1][0]));
+        const T lo =
+          larger(slave_polygon[0][0],
+                 smaller(master_polygon[0][0], master_polygon[1][0]));
+        const T hi =
+          smaller(slave_polygon[1][0],
+                  larger(master_polygon[0][0], master_polygon[1][0]));
         const T length = hi - lo;
         if (value(length) > zero)
-          cells.push_back({ { lo, 0.0 }, { length, 0.0 }, { 0.0, 0.0 }, length });
+          cells.push_back(
+            { { lo, 0.0 }, { length, 0.0 }, { 0.0, 0.0 }, length });
       }
       else
       {
@@ -420,10 +442,18 @@ integrate_pair(FacetType slave_type,
           // Newton on the values; Jets then take two steps that carry the
           // derivatives
           const Point3 xv = values(x);
-          const Projection ps = project_along(
-            slave_type, gdim, slave_values, xv, direction, sf->reference_centre);
-          const Projection pm = project_along(
-            master_type, gdim, master_values, xv, direction, mf.reference_centre);
+          const Projection ps = project_along(slave_type,
+                                              gdim,
+                                              slave_values,
+                                              xv,
+                                              direction,
+                                              sf->reference_centre);
+          const Projection pm = project_along(master_type,
+                                              gdim,
+                                              master_values,
+                                              xv,
+                                              direction,
+                                              mf.reference_centre);
           if (!ps.converged or !pm.converged)
           {
             ++failed;
@@ -437,16 +467,30 @@ integrate_pair(FacetType slave_type,
           }
           else
           {
-            Xs = refine_projection<T>(slave_type, gdim, slave_nodes, x, sf->normal, ps)
+            Xs = refine_projection<T>(
+                   slave_type, gdim, slave_nodes, x, sf->normal, ps)
                    .first;
-            Xm = refine_projection<T>(master_type, gdim, master_nodes, x, sf->normal, pm)
+            Xm = refine_projection<T>(
+                   master_type, gdim, master_nodes, x, sf->normal, pm)
                    .first;
           }
           Vec3<T> xs, xm;
-          cell_geometry<T>(slave_type, gdim, slave_nodes,
-                           std::span<const T>(Xs.data(), tdim), Ns, dNs, xs, tangents);
-          cell_geometry<T>(master_type, gdim, master_nodes,
-                           std::span<const T>(Xm.data(), tdim), Nm, dNm, xm, tangents);
+          cell_geometry<T>(slave_type,
+                           gdim,
+                           slave_nodes,
+                           std::span<const T>(Xs.data(), tdim),
+                           Ns,
+                           dNs,
+                           xs,
+                           tangents);
+          cell_geometry<T>(master_type,
+                           gdim,
+                           master_nodes,
+                           std::span<const T>(Xm.data(), tdim),
+                           Nm,
+                           dNm,
+                           xm,
+                           tangents);
           Vec3<T> n = { 0.0, 0.0, 0.0 };
           for (int a = 0; a < ns; ++a)
             for (int k = 0; k < gdim; ++k)
