@@ -168,3 +168,19 @@ def test_ironing2d_is_path_independent_and_converges(out):
     if MPI.COMM_WORLD.rank == 0:
         assert len(csv_path.read_text().splitlines()) == len(steps) + 1
         assert png_path.stat().st_size > 10_000
+
+
+@pytest.mark.slow
+def test_ironing3d_runs_the_load_path_and_balances(out):
+    """3D ironing, very coarse (h = 1.5, die 0.75, 3 + 3 steps): the whole load path
+    converges, and in steady sliding the drive needs little tangential force."""
+    figures = load_demo("ironing3d").main(
+        ["--h", "1.5", "--h-die", "0.75", "--press-steps", "3", "--slide-steps", "3",
+         "--quiet", "--csv", str(out / "ironing3d.csv")])
+    steps = figures["steps"]
+    assert steps[-1]["t"] == 1.0 and steps[-1]["slide"] == pytest.approx(4.0)
+    pressed = [r for r in steps if r["phase"] == "press"][-1]
+    assert pressed["normal_reaction"] > 0 and pressed["active_nodes"] > 0
+    sliding = [r for r in steps if r["phase"] == "slide"]
+    assert all(abs(r["tangential_reaction"]) < 0.1 * r["normal_reaction"] for r in sliding)
+    assert all(r["terminal_iterations"] > 0 for r in steps)
