@@ -124,8 +124,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
             nodes = np.zeros((len(cells), 1), dtype=np.int64)
         # padding slots carry zero derivatives: any valid dof will do
         nodes = np.where(nodes >= 0, nodes, nodes[:, :1])
-        dofs = (nodes[..., None] * gdim + np.arange(gdim)).reshape(len(cells), -1)
-        nv = dofs.shape[1]
+        # explicit sizes: a rank may have no pair, and reshape(0, -1) is ambiguous
+        nv = nodes.shape[1] * gdim
+        dofs = (nodes[..., None] * gdim + np.arange(gdim)).reshape(len(cells), nv)
         ns = cells.shape[1]
         value = r["value"]
         grad = r["gradient"].reshape(len(cells), ns, nv)
