@@ -143,8 +143,9 @@ class CurrentSurfaceGap(GapModelBase):
         dofs, Dirichlet columns not yet dropped) and data for :meth:`_gap_hessian`."""
         raise NotImplementedError
 
-    def _gap_hessian(self, data: object, Fg: FloatArray) -> PETSc.Mat:
-        """``Σ_A F_g,A ∂²ĝ_A/∂u²`` (dofs × dofs, Dirichlet rows not yet dropped)."""
+    def _gap_hessian(self, data: object, Fg: Optional[FloatArray]) -> PETSc.Mat:
+        """``Σ_A F_g,A ∂²ĝ_A/∂u²`` (dofs × dofs, Dirichlet rows not yet dropped);
+        ``Fg=None``: a matrix with every entry it may have (values arbitrary)."""
         raise NotImplementedError
 
     # -- element quantities ------------------------------------------------------------
@@ -231,6 +232,12 @@ class CurrentSurfaceGap(GapModelBase):
         frozen surface would give: positive semi-definite, for the iterations
         in which the active set still moves (see ContactTerm.assemble_jacobian).
         """
+        return self._jacobian(state, active, mask, geometric, structure_only=False)
+
+    def _jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
+                  geometric: bool, structure_only: bool) -> PETSc.Mat:
+        """:meth:`jacobian`; ``structure_only``: every entry it may have, with
+        the gap's second derivatives as structural zeros (not computed)."""
         state = state.data
         layout = self.slave.layout
         if not geometric:
@@ -260,7 +267,8 @@ class CurrentSurfaceGap(GapModelBase):
         blocks = np.einsum("cq,cqbiej->cbiej", self.wq[None, :] * b, state.element["d2J"])
         K_el = assemble_blocks(self.dofs, self.cell_dofs_local, self.dofs, self.cell_dofs,
                                blocks.reshape(nc, width, width))
-        K_el.axpy(1.0, self._gap_hessian(state.gap_data, state.Fg), structure=Different)
+        K_el.axpy(1.0, self._gap_hessian(state.gap_data, None if structure_only else state.Fg),
+                  structure=Different)
         if mask is not None:
             K_el.diagonalScale(mask, mask)
             K.diagonalScale(mask, mask)
@@ -269,7 +277,7 @@ class CurrentSurfaceGap(GapModelBase):
 
     def pattern(self, state: ContactState) -> PETSc.Mat:
         """The exact Jacobian with every node active: every entry it may have."""
-        return self.jacobian(state, np.ones_like(state.gaps), None)
+        return self._jacobian(state, np.ones_like(state.gaps), None, True, structure_only=True)
 
     def energy(self, u_nodes: FloatArray) -> float:
         """Π_c summed over all ranks (for checking the residual)."""
@@ -329,8 +337,10 @@ class CurrentObstacleGap(CurrentSurfaceGap):
                               dg_c.reshape(nc, nd, nd * gdim))
         return g, G_g, {"e": e, "d": d, "v": v, "hess": hess}
 
-    def _gap_hessian(self, data: dict, Fg: FloatArray) -> PETSc.Mat:
+    def _gap_hessian(self, data: dict, Fg: Optional[FloatArray]) -> PETSc.Mat:
         e, d, v = data["e"], data["d"], data["v"]
+        if Fg is None:                      # the pattern: every cell's block
+            Fg = np.ones(self.slave.layout.size_local)
         cells = self.slave.cells
         nc, nd = cells.shape
         width = nd * self.slave.gdim

@@ -1,6 +1,10 @@
 """Sparse products of the contact operators, in one place."""
 from __future__ import annotations
 
+from typing import Optional
+
+import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 
 
@@ -19,3 +23,42 @@ def transpose_mat_mult(A: PETSc.Mat, B: PETSc.Mat) -> PETSc.Mat:
     product = At.matMult(B)
     At.destroy()
     return product
+
+
+class PatternTrackingAdd:
+    """``A += K`` for a contact stiffness ``K`` whose pattern may change between
+    Newton iterations (pairs come and go as the surfaces move).
+
+    Added with SUBSET_NONZERO_PATTERN, every entry of ``K`` that ``A`` lacks
+    is a malloc inside PETSc, and each one reallocates the row storage: 2.3 s
+    for one Jacobian of Hertz 3D at 30k dofs, ten times the bulk assembly.
+    When ``K``'s pattern differs from the last one added (compared exactly,
+    on every rank), ``A`` is rebuilt once with the union pattern
+    (DIFFERENT_NONZERO_PATTERN: 0.03-0.1 s); otherwise ``K``'s entries are
+    already in ``A``. The rebuild keeps ``A``'s handle, so SNES and the KSP
+    keep using it; what PETSc's rebuild drops (the near-nullspace, the
+    permission to allocate new entries) is put back.
+    """
+
+    def __init__(self) -> None:
+        self._rows: Optional[np.ndarray] = None
+        self._cols: Optional[np.ndarray] = None
+
+    def __call__(self, A: PETSc.Mat, K: PETSc.Mat) -> None:
+        rows, cols, _ = K.getValuesCSR()
+        same = (self._rows is not None and np.array_equal(rows, self._rows)
+                and np.array_equal(cols, self._cols))
+        # MatAXPY is collective: every rank must take the same branch
+        if A.getComm().tompi4py().allreduce(bool(same), op=MPI.LAND):
+            A.axpy(1.0, K, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            return
+        nullspace = A.getNearNullSpace()
+        A.axpy(1.0, K, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        if nullspace is not None and nullspace.handle:
+            A.setNearNullSpace(nullspace)
+        self._rows, self._cols = rows.copy(), cols.copy()
+
+    def reset(self) -> None:
+        """Forget the last pattern (the next add rebuilds ``A``'s pattern)."""
+        self._rows = self._cols = None

@@ -34,6 +34,7 @@ from dolfinx_mortar.contact.augmented import AugmentedNewtonStep
 from dolfinx_mortar.contact.models import ContactOptions, current_model, frozen_model, moved
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.results import ContactResults
+from dolfinx_mortar.contact.sparse_products import PatternTrackingAdd
 from dolfinx_mortar.contact.state import ContactState, GapModel
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.input_checks import check_cells, check_contact_tags
@@ -138,6 +139,8 @@ class ContactTerm(ContactResults):
         self.state: Optional[ContactState] = None
         self._masks: dict = {}
         self._last_active: Optional[FloatArray] = None
+        #: adds K to the Newton matrix when its pattern may change ("current")
+        self._add_stiffness = PatternTrackingAdd()
         self._augmented: Optional[AugmentedNewtonStep] = None
         self._built_at: Optional[FloatArray] = None
         #: global indices of this rank's rows that the last contact Jacobian
@@ -264,7 +267,10 @@ class ContactTerm(ContactResults):
                 self._last_active = active
             K = self.model.jacobian(state, active, mask, geometric=settled)
             self.stiffened_rows = stiffened_rows(K, self.V.dofmap.index_map_bs)
-            A.axpy(1.0, K, structure=SUBSET)
+            if self.basis_configuration == "current":
+                self._add_stiffness(A, K)
+            else:
+                A.axpy(1.0, K, structure=SUBSET)
             A.assemble()
         self._add("jacobian", clock)
 
@@ -297,6 +303,7 @@ class ContactTerm(ContactResults):
             return A
         state = self.state or self.update(bcs)
         A.axpy(1.0, self.model.pattern(state), structure=DIFFERENT)
+        self._add_stiffness.reset()
         if self.moving_pattern or self.basis_configuration == "previous":
             # the pairs, and so the pattern, change with u: new entries are
             # allocated as they come

@@ -1,0 +1,82 @@
+"""Adding a contact stiffness whose pattern moves (PatternTrackingAdd), on 1 and 2 ranks."""
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar.contact.sparse_products import PatternTrackingAdd
+
+N = 40
+
+
+def _matrix(entries, nnz: int) -> PETSc.Mat:
+    """An N × N AIJ matrix with the given (row, col, value) on this rank's rows."""
+    A = PETSc.Mat().createAIJ((N, N), nnz=(nnz, nnz), comm=MPI.COMM_WORLD)
+    start, end = A.getOwnershipRange()
+    for i, j, v in entries:
+        if start <= i < end:
+            A.setValue(i, j, v, addv=PETSc.InsertMode.ADD_VALUES)
+    A.assemble()
+    return A
+
+
+def _laplacian() -> PETSc.Mat:
+    entries = [(i, i, 2.0) for i in range(N)]
+    entries += [(i, i + 1, -1.0) for i in range(N - 1)] + [(i + 1, i, -1.0) for i in range(N - 1)]
+    A = _matrix(entries, 3)
+    A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    return A
+
+
+def _far_coupling(shift: int, scale: float) -> PETSc.Mat:
+    """Entries far off the tridiagonal band, rows on both ranks' parts."""
+    return _matrix([(i, (i + shift) % N, scale * (1 + i)) for i in range(0, N, 3)], 1)
+
+
+def _dense(A: PETSc.Mat) -> np.ndarray:
+    """The whole matrix on every rank (small N)."""
+    start, end = A.getOwnershipRange()
+    local = np.zeros((end - start, N))
+    for i in range(start, end):
+        cols, vals = A.getRow(i)
+        local[i - start, cols] = vals
+    return np.vstack(MPI.COMM_WORLD.allgather(local))
+
+
+def _mallocs(A: PETSc.Mat) -> int:
+    return MPI.COMM_WORLD.allreduce(int(A.getInfo()["mallocs"]))
+
+
+def test_new_entries_are_merged_once_and_the_near_nullspace_is_kept():
+    A = _laplacian()
+    ones = A.createVecRight()
+    ones.set(1.0)
+    A.setNearNullSpace(PETSc.NullSpace().create(vectors=[ones]))
+    expected = _dense(A)
+    add = PatternTrackingAdd()
+    K1, K2 = _far_coupling(17, 0.5), _far_coupling(23, -0.25)
+    for K in (K1, K1, K2, K1):
+        add(A, K)
+        A.assemble()
+        expected += _dense(K)
+        scale = np.max(np.abs(expected))
+        assert np.max(np.abs(_dense(A) - expected)) <= 1e-14 * scale
+        # new entries were merged with a preallocated rebuild, not added one
+        # malloc at a time (the slow path this class exists to avoid)
+        assert _mallocs(A) == 0
+        nullspace = A.getNearNullSpace()
+        assert nullspace is not None and nullspace.handle
+        assert abs(nullspace.getVecs()[0].norm() - np.sqrt(N)) <= 1e-12 * np.sqrt(N)
+    # entries outside A's pattern still allocate as they come afterwards
+    A.setValue(A.getOwnershipRange()[0], N - 1, 1.0, addv=PETSc.InsertMode.ADD_VALUES)
+    A.assemble()
+
+
+def test_plain_subset_add_would_malloc():
+    """What the check above guards against: the same K added with
+    SUBSET_NONZERO_PATTERN allocates entry by entry."""
+    A = _laplacian()
+    A.axpy(1.0, _far_coupling(17, 0.5), structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+    A.assemble()
+    assert _mallocs(A) > 0
