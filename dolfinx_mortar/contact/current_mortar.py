@@ -36,6 +36,10 @@ IntArray = npt.NDArray[np.int64]
 
 #: facet types with exact derivatives of the current-configuration gap in 3D
 SUPPORTED_3D = ("P1 triangle", "Q1 quadrilateral")
+#: the search radius of each slave facet, in its own diameters, when no
+#: search_radius is given: surfaces further apart than that carry no force or
+#: stiffness, and a penetration that deep is far outside a penalty solution
+FACET_SEARCH_FACTOR = 2.0
 
 
 class CurrentMortarGap(CurrentSurfaceGap):
@@ -50,7 +54,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
         As for :class:`~dolfinx_mortar.contact.finite_deformation.CurrentSurfaceGap`.
     search_radius
         As for :class:`~dolfinx_mortar.mortar.coupling.MortarCoupling` (pairs are found
-        again at every evaluation).
+        again at every evaluation); default: each slave facet searches
+        :data:`FACET_SEARCH_FACTOR` of its own diameters.
     """
 
     moving_pattern = True
@@ -106,8 +111,14 @@ class CurrentMortarGap(CurrentSurfaceGap):
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
         slave, layout = self.slave, self.slave.layout
         gdim = slave.gdim
+        # the pairs are found again at every evaluation, and only those near
+        # contact matter: each facet searches two of its own diameters
+        # (unless the user set a radius), not the largest facet's
         coupling = MortarCoupling(slave.moved(u_nodes), self.master.moved(u_nodes),
-                                  search_radius=self.search_radius)
+                                  search_radius=self.search_radius,
+                                  facet_search_factor=(FACET_SEARCH_FACTOR
+                                                       if self.search_radius is None
+                                                       else None))
         self.coupling = coupling
         all_cells = slave.cells[coupling.pairs[:, 0]]
         # the values of every pair from the double kernel; derivatives only

@@ -138,6 +138,13 @@ class MortarCoupling:
     search_radius
         How far apart facets may be and still be paired; default the largest
         slave facet diameter.
+    facet_search_factor
+        Instead of one ``search_radius``, pair each slave facet with the master
+        facets within this multiple of its own diameter. On a graded mesh the
+        largest facet sets the default radius for all: on Hertz 3D at 52k
+        dofs it made 812k candidates for 6.9k pairs (0.70 s of segmentation),
+        against 70k candidates with a factor of 2 (the same pairs wherever
+        the surfaces are closer than two local element lengths).
     quadrature_degree
         Degree of the rule on each segment; the default integrates the
         products of slave and master functions exactly on affine facets
@@ -163,7 +170,8 @@ class MortarCoupling:
                  master_displacement: Optional[FloatArray] = None,
                  search_radius: Optional[float] = None,
                  quadrature_degree: Optional[int] = None,
-                 opposing_normals_only: bool = True, keep_points: bool = False):
+                 opposing_normals_only: bool = True, keep_points: bool = False,
+                 facet_search_factor: Optional[float] = None):
         if slave.gdim != master.gdim:
             raise ValueError(f"slave ({slave.gdim}D) and master ({master.gdim}D) surfaces "
                              "live in different dimensions")
@@ -189,15 +197,25 @@ class MortarCoupling:
         self.master_global_ids = master_copy.global_ids
         self.master_cells = master_copy.cells
 
+        # each slave facet's diameter (its largest coordinate extent)
+        diameters = np.max(np.ptp(xs[slave.cells], axis=1), axis=1, initial=0.0)
         if search_radius is None:
-            diam = np.max(np.ptp(xs[slave.cells], axis=1), initial=0.0)
-            search_radius = comm.allreduce(float(np.max(diam, initial=0.0)), op=MPI.MAX)
+            search_radius = comm.allreduce(float(np.max(diameters, initial=0.0)), op=MPI.MAX)
         if not np.isfinite(search_radius) or search_radius < 0:
             raise ValueError(f"search radius must be finite and non-negative, got {search_radius}")
         self.search_radius = float(search_radius)
         slave_cells = slave.cells.astype(np.int32)
-        slave_boxes = _kernels.facet_bounding_boxes(slave.facet_type, xs, slave_cells,
-                                                    self.search_radius)
+        if facet_search_factor is None:
+            slave_boxes = _kernels.facet_bounding_boxes(slave.facet_type, xs, slave_cells,
+                                                        self.search_radius)
+        else:
+            if not (np.isfinite(facet_search_factor) and facet_search_factor > 0):
+                raise ValueError("facet_search_factor must be positive and finite, got "
+                                 f"{facet_search_factor!r}")
+            slave_boxes = _kernels.facet_bounding_boxes(slave.facet_type, xs, slave_cells, 0.0)
+            margin = facet_search_factor * diameters[:, None]
+            slave_boxes[:, :3] -= margin
+            slave_boxes[:, 3:] += margin
         master_boxes = _kernels.facet_bounding_boxes(master.facet_type, master_copy.x,
                                                      master_copy.cells, 0.0)
         candidates = _kernels.overlapping_box_pairs(slave_boxes, master_boxes)

@@ -288,3 +288,36 @@ def test_axisymmetric_integrals_carry_the_circumference(degree):
     assert abs(gap.sum() - g * np.pi) < 1e-12
     with pytest.raises(ValueError, match="both be axisymmetric"):
         MortarCoupling(slave, flat_line(degree, 5, y=-g, up=False))
+
+
+def _graded_slave() -> LagrangeSurface:
+    """Fifty facets of length 0.01 on [0, 0.5], then one of length 2.5 (y = 0, facing +y)."""
+    from dolfinx_mortar.surfaces.structured import line_chain
+    s, cells = line_chain(np.concatenate([np.linspace(0.0, 0.5, 51), [3.0]]), 1)
+    surface = LagrangeSurface("interval", 1, np.column_stack([s, np.zeros_like(s)]), cells)
+    return surface.reflected(np.ones(len(cells), dtype=bool))      # normals +y
+
+
+def test_facet_search_finds_the_close_pairs_from_far_fewer_candidates():
+    """Each facet searching two of its own diameters: on a graded slave the
+    same pairs as the largest facet's radius wherever the surfaces are close,
+    from a fraction of the candidates."""
+    slave = _graded_slave()
+    master = flat_line(1, 320, bounds=(-0.1, 3.1), y=0.004, up=False)
+    default = MortarCoupling(slave, master)
+    local = MortarCoupling(slave, master, facet_search_factor=2.0)
+    assert {tuple(p) for p in local.pairs} == {tuple(p) for p in default.pairs}
+    assert np.allclose(local.covered_area, default.covered_area, rtol=0, atol=1e-14 * 3.0)
+    assert abs(np.sum(local.covered_area) - 3.0) <= 1e-12 * 3.0
+    assert local.num_candidates < default.num_candidates / 5
+
+
+def test_facet_search_ignores_a_master_beyond_two_facet_diameters():
+    slave = _graded_slave()
+    master = flat_line(1, 320, bounds=(-0.1, 3.1), y=0.1, up=False)   # 10 small facets away
+    local = MortarCoupling(slave, master, facet_search_factor=2.0)
+    assert not np.any(local.pairs[:, 0] < 50)                         # small facets: no pair
+    assert abs(local.covered_area[50] - 2.5) <= 1e-12 * 2.5          # the long facet reaches
+    assert abs(np.sum(MortarCoupling(slave, master).covered_area) - 3.0) <= 1e-12 * 3.0
+    with pytest.raises(ValueError, match="facet_search_factor"):
+        MortarCoupling(slave, master, facet_search_factor=-1.0)
