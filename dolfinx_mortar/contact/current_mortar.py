@@ -50,8 +50,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
     ----------
     slave, master
         The surfaces in the reference configuration (one displacement space).
-    kind, penalty, scaling
-        As for :class:`~dolfinx_mortar.contact.finite_deformation.CurrentSurfaceGap`.
+    kind, penalty, scaling, pointwise
+        As for :class:`~dolfinx_mortar.contact.finite_deformation.CurrentSurfaceGap`
+        (pointwise: ⟨d⟩ at the segment quadrature points, as with frozen bases).
     search_radius
         As for :class:`~dolfinx_mortar.mortar.coupling.MortarCoupling` (pairs are found
         again at every evaluation); default: each slave facet searches
@@ -62,7 +63,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
 
     def __init__(self, slave: LagrangeSurface, master: LagrangeSurface, kind: KindLike,
                  penalty: float, scaling: str = "consistent",
-                 search_radius: Optional[float] = None):
+                 search_radius: Optional[float] = None, pointwise: bool = False):
         if slave.gdim == 3 and not (slave.reference.name in SUPPORTED_3D
                                     and master.reference.name in SUPPORTED_3D):
             raise NotImplementedError(
@@ -72,7 +73,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
                 "54-81 variables per pair, which the kernels do not instantiate")
         if master.layout.size_global != slave.layout.size_global:
             raise ValueError("slave and master must share one displacement space (one mesh)")
-        super().__init__(slave, kind, penalty, scaling)
+        super().__init__(slave, kind, penalty, scaling, pointwise=pointwise)
         self.master, self.search_radius = master, search_radius
         degree = polynomial_degree(slave) + max(polynomial_degree(slave),
                                                  polynomial_degree(master))
@@ -86,7 +87,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
 
     def pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
                          which: Optional[npt.NDArray[np.bool_]] = None,
-                         with_hessian: bool = True) -> dict:
+                         with_hessian: bool = True, with_positive_part: bool = False) -> dict:
         """``c_A = ∫ N_A d`` of the pairs of ``coupling`` (all, or those where
         ``which`` is True) with exact derivatives (the Hessians only with
         ``with_hessian``).
@@ -94,7 +95,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
         Returns the kernel's arrays: ``value`` (pairs, ns), ``gradient``
         (pairs, ns, nv), ``hessian`` (pairs, ns, nv, nv) and ``nodes`` (pairs,
         nv / gdim), the global node ids of the variables (slave cell, other
-        slave nodes, master cell; −1 pads).
+        slave nodes, master cell; −1 pads); with ``with_positive_part`` also
+        ``value_plus`` and ``gradient_plus``, the same for ``c⁺_A = ∫ N_A ⟨d⟩``.
         """
         slave = self.slave
         copy = gather_surface(slave, slave.x + u_nodes)
@@ -105,7 +107,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
             slave.facet_type, copy.x, copy.cells, copy.global_ids.astype(np.int64),
             master.facet_type, master.x, master.cells, master.global_ids.astype(np.int64),
             pairs.astype(np.int32), self.segment_points, self.segment_weights,
-            coupling.zero_length, with_hessian=with_hessian)
+            coupling.zero_length, with_hessian=with_hessian,
+            with_positive_part=with_positive_part)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
@@ -118,18 +121,28 @@ class CurrentMortarGap(CurrentSurfaceGap):
                                   search_radius=self.search_radius,
                                   facet_search_factor=(FACET_SEARCH_FACTOR
                                                        if self.search_radius is None
-                                                       else None))
+                                                       else None),
+                                  keep_points=self.pointwise)
         self.coupling = coupling
         all_cells = slave.cells[coupling.pairs[:, 0]]
         # the values of every pair from the double kernel; derivatives only
         # where a node may carry contact force or stiffness
         g = layout.sum_at_functions(all_cells, coupling.raw_pairs[2] @ self.C)
         near = self.near_contact(g, self._lumped_weights(e))
+        if self.pointwise:
+            # every node with a penetrating point in its support has ĝ⁺ ≠ 0,
+            # whatever its mean gap: its pairs need derivatives too (decided
+            # on the points' values, as the kernel's ⟨d⟩ is)
+            points = coupling.points
+            penetrating = np.zeros(len(coupling.pairs), dtype=bool)
+            penetrating[points["pairs"][points["gap"] > 0]] = True
+            near |= layout.on_cells(all_cells[penetrating])
         kept = np.any(near[all_cells], axis=1)
         cells = all_cells[kept]
         # the residual needs gradients only; _gap_hessian asks for the Hessians
         # when (and if) a Jacobian is assembled at this u
-        r = self.pair_derivatives(u_nodes, coupling, kept, with_hessian=False)
+        r = self.pair_derivatives(u_nodes, coupling, kept, with_hessian=False,
+                                  with_positive_part=self.pointwise)
         dofs = self._variable_dofs(r["nodes"], len(cells))
         nv = dofs.shape[1]
         ns = cells.shape[1]
@@ -140,9 +153,15 @@ class CurrentMortarGap(CurrentSurfaceGap):
         grad = np.einsum("pbn,ba->pan", grad, self.C)
         self.covered = layout.on_cells(all_cells)
         G_g = assemble_blocks(layout, cells, self.dofs, dofs, grad)
-        return g, G_g, {"cells": cells, "dofs": dofs, "value": value,
-                        "pairs": np.flatnonzero(kept), "u_nodes": u_nodes,
-                        "coupling": coupling, "kept": kept}
+        data = {"cells": cells, "dofs": dofs, "value": value, "pairs": np.flatnonzero(kept),
+                "u_nodes": u_nodes, "coupling": coupling, "kept": kept}
+        if self.pointwise:
+            # ĝ⁺ from the kept pairs: every pair with a penetrating point is kept
+            data["g_plus"] = layout.sum_at_functions(cells, r["value_plus"] @ self.C)
+            grad_plus = np.einsum("pbn,ba->pan",
+                                  r["gradient_plus"].reshape(len(cells), ns, nv), self.C)
+            data["G_g_plus"] = assemble_blocks(layout, cells, self.dofs, dofs, grad_plus)
+        return g, G_g, data
 
     def near_contact(self, g: FloatArray, W: FloatArray) -> npt.NDArray[np.bool_]:
         """Nodes whose gap derivatives are needed: those that may get contact
@@ -181,12 +200,13 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # Σ_a F_g,a ∂²ĝ_a = Σ_b (C F_g)_b ∂²c_b (C applied to the weights, a
         # small product, instead of to the Hessians)
         weights = Fg[cells] @ self.C.T
-        # F_g = ε W^(m-k) max(y, 0) vanishes at every node that does not
-        # penetrate (the positive part's own decision, y > 0), so a pair none
-        # of whose nodes penetrates adds nothing: its Hessian (100-200 times
-        # the cost of its values) is skipped. On Hertz 3D these are most of
-        # the pairs kept for the gradients.
-        needed = np.any(Fg[cells] > 0, axis=1)
+        # F_g = ε W^(m-k) max(y, 0) (nodal set) or ε W^(m-k) y⁺ (pointwise, a
+        # sum over the penetrating points only) is exactly zero at a node with
+        # no penetration: the positive part's own decision, not a tolerance.
+        # A pair none of whose nodes has F_g ≠ 0 adds nothing, and its Hessian
+        # (100-200 times the cost of its values) is skipped. On Hertz 3D these
+        # are most of the pairs kept for the gradients.
+        needed = np.any(Fg[cells] != 0.0, axis=1)
         which = np.zeros(len(data["kept"]), dtype=bool)
         which[data["pairs"][needed]] = True
         r = self.pair_derivatives(data["u_nodes"], data["coupling"], which,

@@ -82,6 +82,9 @@ class CurrentState:
     FW: FloatArray           #: ∂F/∂W_A at the local nodes
     element: dict            #: area-element arrays the second derivatives of W need
     gap_data: object         #: what the gap's source needs for Σ_A F_g,A ∂²ĝ_A
+    #: pointwise active set: y⁺ = ĝ⁺ W^{−k} with ĝ⁺_A = ∫ φ_A ⟨d⟩ da, and ∂y⁺/∂u
+    y_plus: Optional[FloatArray] = None
+    G_y_plus: Optional[PETSc.Mat] = None
 
 
 class CurrentSurfaceGap(GapModelBase):
@@ -100,15 +103,25 @@ class CurrentSurfaceGap(GapModelBase):
         not supported, dual kinds only on P1 lines and triangles.
     quadrature_degree
         Degree of the rule for W on every slave facet (default 2p + 2).
+    pointwise
+        The pointwise active set (DESIGN.md §3): the nodal pressures come from
+        ``ĝ⁺_A = ∫ φ_A ⟨d⟩ da`` evaluated at the quadrature points (cells and
+        segments are not split at d = 0). It has no potential; its virtual
+        work is the nodal one with ``⟨y_A⟩`` replaced by ``y⁺_A = ĝ⁺_A W_A^{−k}``,
+        ``δΠ = Σ_A ε W^{m−k} y⁺ δĝ_A + ε (m/2 − k) W^{m−1} (y⁺)² δW_A``, so that
+        it is the nodal model wherever every point of a node's support
+        penetrates, and the Jacobian is its exact (unsymmetric) derivative.
     """
 
     def __init__(self, slave: LagrangeSurface, kind: KindLike, penalty: float,
-                 scaling: str = "consistent", quadrature_degree=None):
+                 scaling: str = "consistent", quadrature_degree=None,
+                 pointwise: bool = False):
         if is_global(kind):
             raise NotImplementedError(
                 f"basis_configuration='current' with {kind_name(kind)}: L(u) couples every "
                 "slave facet and its linearization is not implemented; use a local kind")
         super().__init__(slave, kind, penalty, scaling)
+        self.pointwise = bool(pointwise)
         ref = slave.reference
         affine = ref.degree == 1 and ref.cell in ("interval", "triangle")
         if self.kind in DUAL_KINDS and not affine:
@@ -140,7 +153,9 @@ class CurrentSurfaceGap(GapModelBase):
     # -- what a gap source provides ------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, object]:
         """``ĝ_A`` at the local nodes (summed over ranks), ``∂ĝ/∂u`` (slave rows ×
-        dofs, Dirichlet columns not yet dropped) and data for :meth:`_gap_hessian`."""
+        dofs, Dirichlet columns not yet dropped) and data for :meth:`_gap_hessian`;
+        with :attr:`pointwise` the data also hold ``"g_plus"`` (ĝ⁺, summed over
+        ranks) and ``"G_g_plus"`` (∂ĝ⁺/∂u)."""
         raise NotImplementedError
 
     def _gap_hessian(self, data: object, Fg: Optional[FloatArray]) -> PETSc.Mat:
@@ -183,6 +198,10 @@ class CurrentSurfaceGap(GapModelBase):
         """The contact state at the displacement Function ``u``
         (:class:`CurrentState` in ``data``)."""
         current = self.evaluate_nodes(nodal_displacement(self.slave, u), mask)
+        if self.pointwise:
+            return ContactState(current.y, current.G_y, self.weights * current.y_plus,
+                                current.residual, gaps_plus=current.y_plus,
+                                G_plus=current.G_y_plus, data=current)
         return ContactState(current.y, current.G_y, self.weights * np.maximum(current.y, 0.0),
                             current.residual, data=current)
 
@@ -200,29 +219,46 @@ class CurrentSurfaceGap(GapModelBase):
         dW_c = np.einsum("q,qa,cqbi->cabi", self.wq, self.N, e["dJ"])
         G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
                               dW_c.reshape(nc, nd, nd * gdim))
+        G_g_plus = gap_data["G_g_plus"] if self.pointwise else None
         if mask is not None:
             G_g.diagonalScale(None, mask)
             G_W.diagonalScale(None, mask)
+            if G_g_plus is not None:
+                G_g_plus.diagonalScale(None, mask)
         y, Fg, FW, _, _, _ = self._nodal_coefficients(g, W, np.zeros_like(g))
+        Wsafe = np.where(W > 0, W, 1.0)
+        y_plus = G_y_plus = None
+        if self.pointwise:
+            # the nodal virtual work with ⟨y⟩ replaced by y⁺ (see the class)
+            y_plus = gap_data["g_plus"] * Wsafe ** (-self.k)
+            Fg = self.penalty * Wsafe ** (self.m - self.k) * y_plus
+            FW = self.penalty * (self.m / 2 - self.k) * y_plus ** 2 * Wsafe ** (self.m - 1)
+            G_y_plus = self._nodal_gap_derivative(G_g_plus, G_W, y_plus, Wsafe)
         residual = G_g.createVecRight()
         tmp = G_W.createVecRight()
         G_g.multTranspose(layout.vector(Fg), residual)
         G_W.multTranspose(layout.vector(FW), tmp)
         residual.axpy(1.0, tmp)
-        # ∂y = W^{-k} ∂ĝ − k y W^{-1} ∂W
-        Wsafe = np.where(W > 0, W, 1.0)
+        G_y = self._nodal_gap_derivative(G_g, G_W, y, Wsafe)
+        #: ω_A for the problem's fallback and gap-closing start
+        self.weights = self.penalty * Wsafe ** self.m
+        self._current_weights = W
+        self.coefficients_std = np.broadcast_to(self.C, (nc, nd, nd)) * (
+            Wsafe[cells] ** (-self.k))[:, None, :]
+        return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, e, gap_data,
+                            y_plus, G_y_plus)
+
+    def _nodal_gap_derivative(self, G_g: PETSc.Mat, G_W: PETSc.Mat, y: FloatArray,
+                              Wsafe: FloatArray) -> PETSc.Mat:
+        """∂y/∂u of ``y = ĝ W^{−k}``: ``W^{−k} ∂ĝ − k y W^{−1} ∂W`` (also for y⁺ from ĝ⁺)."""
+        layout = self.slave.layout
         G_y = G_g.copy()
         G_y.diagonalScale(layout.vector(Wsafe ** (-self.k)), None)
         if self.k:
             scaled = G_W.copy()
             scaled.diagonalScale(layout.vector(-y / Wsafe), None)
             G_y.axpy(1.0, scaled, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        #: ω_A for the problem's fallback and gap-closing start
-        self.weights = self.penalty * Wsafe ** self.m
-        self._current_weights = W
-        self.coefficients_std = np.broadcast_to(self.C, (nc, nd, nd)) * (
-            Wsafe[cells] ** (-self.k))[:, None, :]
-        return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, e, gap_data)
+        return G_y
 
     def jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
                  geometric: bool = True) -> PETSc.Mat:
@@ -240,11 +276,17 @@ class CurrentSurfaceGap(GapModelBase):
         the gap's second derivatives as structural zeros (not computed)."""
         state = state.data
         layout = self.slave.layout
+        # pointwise: while nothing penetrates, G⁺ = 0 and the nodal form
+        # (non-geometric) stiffens the touching nodes instead, as when frozen
+        pointwise = (self.pointwise and not structure_only
+                     and self.any_penetration(state.y_plus))
+        if self.pointwise and not structure_only and not pointwise:
+            geometric = False
         if not geometric:
-            right = state.G_y.copy()
-            right.diagonalScale(layout.vector(self.weights * active), None)
+            right = (state.G_y_plus if pointwise else state.G_y).copy()
+            right.diagonalScale(layout.vector(self.weights * (1.0 if pointwise else active)),
+                                None)
             return transpose_mat_mult(state.G_y, right)
-        _, _, _, Fgg, FgW, FWW = self._nodal_coefficients(state.g, state.W, active)
 
         def scaled(M: PETSc.Mat, s: FloatArray) -> PETSc.Mat:
             out = M.copy()
@@ -252,11 +294,25 @@ class CurrentSurfaceGap(GapModelBase):
             return out
 
         Different = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
-        # outer products: G_gᵀ(Fgg G_g + FgW G_W) + G_Wᵀ(FgW G_g + FWW G_W)
-        left = scaled(state.G_g, Fgg)
-        left.axpy(1.0, scaled(state.G_W, FgW), structure=Different)
-        right = scaled(state.G_g, FgW)
-        right.axpy(1.0, scaled(state.G_W, FWW), structure=Different)
+        if pointwise:
+            # ∂F_g = a1 ∂y⁺ + b1 ∂W and ∂F_W = a2 ∂y⁺ + b2 ∂W of the pointwise
+            # virtual work's coefficients F_g = ε W^(m−k) y⁺, F_W = ε(m/2−k) W^(m−1) y⁺²
+            eps, k, m = self.penalty, self.k, self.m
+            W = np.where(state.W > 0, state.W, 1.0)
+            yp = state.y_plus
+            left = scaled(state.G_y_plus, eps * W ** (m - k))
+            left.axpy(1.0, scaled(state.G_W, eps * (m - k) * W ** (m - k - 1) * yp),
+                      structure=Different)
+            right = scaled(state.G_y_plus, 2 * eps * (m / 2 - k) * yp * W ** (m - 1))
+            right.axpy(1.0, scaled(state.G_W, eps * (m / 2 - k) * (m - 1) * yp ** 2
+                                   * W ** (m - 2)), structure=Different)
+        else:
+            _, _, _, Fgg, FgW, FWW = self._nodal_coefficients(state.g, state.W, active)
+            # outer products: G_gᵀ(Fgg G_g + FgW G_W) + G_Wᵀ(FgW G_g + FWW G_W)
+            left = scaled(state.G_g, Fgg)
+            left.axpy(1.0, scaled(state.G_W, FgW), structure=Different)
+            right = scaled(state.G_g, FgW)
+            right.axpy(1.0, scaled(state.G_W, FWW), structure=Different)
         K = transpose_mat_mult(state.G_g, left)
         K.axpy(1.0, transpose_mat_mult(state.G_W, right), structure=Different)
         # second derivatives: Σ_A F_W,A ∂²W_A here, Σ_A F_g,A ∂²ĝ_A from the source
@@ -298,7 +354,8 @@ class CurrentSurfaceGap(GapModelBase):
     def pressures_from_gaps(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
         """``p_A`` in the PU basis on the current surface (see ObstacleGap)."""
         W = self.lumped_weights
-        force = self.penalty * np.where(W > 0, W, 1.0) ** self.m * np.maximum(gaps, 0.0)
+        force = self.penalty * np.where(W > 0, W, 1.0) ** self.m * (
+            np.maximum(gaps, 0.0) if positive_part else gaps)
         if self.k == 0:
             return force
         return np.divide(force, W, out=np.zeros_like(W), where=W > 0)
@@ -313,10 +370,11 @@ class CurrentObstacleGap(CurrentSurfaceGap):
     """
 
     def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: KindLike,
-                 penalty: float, scaling: str = "consistent", quadrature_degree=None):
+                 penalty: float, scaling: str = "consistent", quadrature_degree=None,
+                 pointwise: bool = False):
         if obstacle.gdim != slave.gdim:
             raise ValueError(f"a {obstacle.gdim}D obstacle cannot touch a {slave.gdim}D body")
-        super().__init__(slave, kind, penalty, scaling, quadrature_degree)
+        super().__init__(slave, kind, penalty, scaling, quadrature_degree, pointwise)
         self.obstacle = obstacle
 
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
@@ -335,7 +393,19 @@ class CurrentObstacleGap(CurrentSurfaceGap):
                 + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["J"], v))
         G_g = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
                               dg_c.reshape(nc, nd, nd * gdim))
-        return g, G_g, {"e": e, "d": d, "v": v, "hess": hess}
+        data = {"e": e, "d": d, "v": v, "hess": hess}
+        if self.pointwise:
+            # ⟨d⟩ and its derivative H(d)∇d at the same points (not split at d = 0)
+            penetrating = d > 0
+            dp = np.where(penetrating, d, 0.0)
+            data["g_plus"] = layout.sum_at_functions(
+                cells, np.einsum("cq,qa->ca", wJ * dp, self.phi))
+            dgp_c = (np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, dp, e["dJ"])
+                     + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi,
+                                 e["J"] * penetrating, v))
+            data["G_g_plus"] = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
+                                               dgp_c.reshape(nc, nd, nd * gdim))
+        return g, G_g, data
 
     def _gap_hessian(self, data: dict, Fg: Optional[FloatArray]) -> PETSc.Mat:
         e, d, v = data["e"], data["d"], data["v"]

@@ -69,9 +69,6 @@ class ContactOptions:
         if basis_configuration == "current" and boundary_modification:
             raise NotImplementedError("basis_configuration='current' with the boundary "
                                       "modification is not implemented")
-        if basis_configuration == "current" and active_set == "pointwise":
-            raise NotImplementedError("basis_configuration='current' is implemented for the "
-                                      "nodal active set only")
         if basis_configuration == "current" and axisymmetric:
             raise NotImplementedError("basis_configuration='current' with axisymmetric=True: "
                                       "the measure 2πr ds moves with u_r and its "
@@ -97,11 +94,12 @@ def current_model(options: ContactOptions, slave: LagrangeSurface,
                   master: Optional[LagrangeSurface],
                   obstacle: Optional[RigidObstacle]) -> GapModel:
     """The model with the bases on the current surface, exact Jacobian."""
+    pointwise = options.active_set == "pointwise"
     if obstacle is not None:
         return CurrentObstacleGap(slave, obstacle, options.kind, options.penalty,
-                                  options.scaling)
+                                  options.scaling, pointwise=pointwise)
     return CurrentMortarGap(slave, master, options.kind, options.penalty, options.scaling,
-                            options.search_radius)
+                            options.search_radius, pointwise=pointwise)
 
 
 def frozen_model(options: ContactOptions, slave: LagrangeSurface,

@@ -379,7 +379,8 @@ PYBIND11_MODULE(_kernels, m)
        const array_t& weights,
        double zero,
        bool opposing_normals_only,
-       bool with_hessian)
+       bool with_hessian,
+       bool with_positive_part)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
@@ -396,7 +397,8 @@ PYBIND11_MODULE(_kernels, m)
           as_span(weights),
           zero,
           opposing_normals_only,
-          with_hessian);
+          with_hessian,
+          with_positive_part);
       }
       const auto np = static_cast<py::ssize_t>(pairs.size() / 2);
       const py::ssize_t ns = cs.shape(1);
@@ -408,6 +410,9 @@ PYBIND11_MODULE(_kernels, m)
       out["gradient"] = to_numpy(r.gradient, { np, ns, nv });
       const py::ssize_t nh = with_hessian ? nv : 0;
       out["hessian"] = to_numpy(r.hessian, { np, ns, nh, nh });
+      const py::ssize_t npp = with_positive_part ? np : 0;
+      out["value_plus"] = to_numpy(r.value_plus, { npp, ns });
+      out["gradient_plus"] = to_numpy(r.gradient_plus, { npp, ns, nv });
       out["failed_projections"] = r.failed_projections;
       return out;
     },
@@ -425,8 +430,10 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("zero"),
     py::arg("opposing_normals_only") = true,
     py::arg("with_hessian") = true,
+    py::arg("with_positive_part") = false,
     "Current-configuration mortar gaps of cell pairs with exact gradients "
-    "and Hessians");
+    "and Hessians (and, with_positive_part, the pointwise active set's "
+    "integrals of <d> with their gradients)");
 
   m.def(
     "averaged_normal_derivatives",

@@ -242,7 +242,8 @@ normal_derivatives(const FacetSurface& s,
 
 /// c_A of one pair as Jets over its slave coordinates, nodal normals and
 /// master coordinates (in that order); returns failed projections. Order 1:
-/// no Hessian (@p hess untouched).
+/// no Hessian (@p hess untouched). Non-empty @p value_plus: also c⁺_A =
+/// ∫ N_A ⟨d⟩ and its gradient (@p grad_plus).
 template<int N, int Order>
 std::int64_t
 inner_pair_derivatives(FacetType slave_type,
@@ -257,7 +258,9 @@ inner_pair_derivatives(FacetType slave_type,
                        bool opposing_normals_only,
                        std::span<double> value,
                        std::span<double> grad,
-                       std::span<double> hess)
+                       std::span<double> hess,
+                       std::span<double> value_plus,
+                       std::span<double> grad_plus)
 {
   using J = Jet<N, Order>;
   std::vector<J> s(slave_nodes.size()), n(normals.size()),
@@ -270,7 +273,19 @@ inner_pair_derivatives(FacetType slave_type,
   for (std::size_t i = 0; i < m.size(); ++i)
     m[i] = J::variable(master_nodes[i], v++);
   const int ns = facet_num_nodes(slave_type);
-  std::vector<J> c(ns, J(0.0));
+  std::vector<J> c(ns, J(0.0)), cp(value_plus.empty() ? 0 : ns, J(0.0));
+  auto accumulate = [&](const SegmentPoint<J>& q)
+  {
+    const J wd = q.weight * q.gap;
+    for (int a = 0; a < ns; ++a)
+      c[a] += wd * q.slave_N[a];
+    if (cp.empty())
+      return;
+    // ⟨d⟩, decided on the value (as the double segmentation's points are)
+    const J wp = q.weight * larger(q.gap, J(0.0));
+    for (int a = 0; a < ns; ++a)
+      cp[a] += wp * q.slave_N[a];
+  };
   const std::int64_t failed = integrate_pair<J>(slave_type,
                                                 master_type,
                                                 gdim,
@@ -282,18 +297,18 @@ inner_pair_derivatives(FacetType slave_type,
                                                 zero,
                                                 opposing_normals_only,
                                                 false,
-                                                [&](const SegmentPoint<J>& q)
-                                                {
-                                                  const J wd = q.weight * q.gap;
-                                                  for (int a = 0; a < ns; ++a)
-                                                    c[a] += wd * q.slave_N[a];
-                                                });
+                                                accumulate);
   for (int a = 0; a < ns; ++a)
   {
     value[a] = c[a].v;
     std::copy(c[a].g.begin(), c[a].g.end(), grad.data() + a * N);
     if constexpr (Order == 2)
       unpack(c[a], value[a], grad.data() + a * N, hess.data() + a * N * N);
+  }
+  for (std::size_t a = 0; a < cp.size(); ++a)
+  {
+    value_plus[a] = cp[a].v;
+    std::copy(cp[a].g.begin(), cp[a].g.end(), grad_plus.data() + a * N);
   }
   return failed;
 }
@@ -308,6 +323,8 @@ using InnerFunction = std::int64_t (*)(FacetType,
                                        std::span<const double>,
                                        double,
                                        bool,
+                                       std::span<double>,
+                                       std::span<double>,
                                        std::span<double>,
                                        std::span<double>,
                                        std::span<double>);
@@ -362,7 +379,8 @@ current_pair_gaps(const FacetSurface& slave,
                   std::span<const double> weights,
                   double zero,
                   bool opposing_normals_only,
-                  bool with_hessian)
+                  bool with_hessian,
+                  bool with_positive_part)
 {
   slave.check();
   master.check();
@@ -402,14 +420,16 @@ current_pair_gaps(const FacetSurface& slave,
   struct PairResult
   {
     std::vector<std::int64_t> nodes;
-    std::vector<double> value, gradient, hessian;
+    std::vector<double> value, gradient, hessian, value_plus, gradient_plus;
   };
   const std::size_t P = pairs.size() / 2;
   std::vector<PairResult> results(P);
   PairGapDerivatives out;
   std::vector<double> xs(ns * gdim), xm(nm * gdim), normals(ns * gdim);
   std::vector<double> value(ns), grad(ns * N),
-    hess(with_hessian ? ns * N * N : 0);
+    hess(with_hessian ? ns * N * N : 0),
+    value_plus(with_positive_part ? ns : 0),
+    grad_plus(with_positive_part ? ns * N : 0);
   for (std::size_t p = 0; p < P; ++p)
   {
     const auto cs = static_cast<std::size_t>(pairs[2 * p]);
@@ -450,7 +470,9 @@ current_pair_gaps(const FacetSurface& slave,
                                     opposing_normals_only,
                                     value,
                                     grad,
-                                    hess);
+                                    hess,
+                                    value_plus,
+                                    grad_plus);
     // the inner variables as functions of the nodes: identity for the
     // coordinates, the averaged normals' derivatives for the normals
     std::vector<double> J(N * K, 0.0), normal_hessians(ns * gdim * K * K, 0.0);
@@ -485,23 +507,31 @@ current_pair_gaps(const FacetSurface& slave,
       for (int k = 0; k < gdim; ++k)
         column[(2 * ns + c) * gdim + k] = (num_slave + c) * gdim + k;
 
-    r.value = value;
-    r.gradient.resize(ns * K);
-    if (!with_hessian)
+    // g = Jᵀ gf for each of the ns rows of @p from
+    auto chain_gradient =
+      [&](const std::vector<double>& from, std::vector<double>& to)
     {
-      // g = Jᵀ gf
-      std::fill(r.gradient.begin(), r.gradient.end(), 0.0);
+      to.assign(ns * K, 0.0);
       for (int a = 0; a < ns; ++a)
         for (int i = 0; i < N; ++i)
         {
-          const double gi = grad[a * N + i];
-          double* g = r.gradient.data() + a * K;
+          const double gi = from[a * N + i];
+          double* g = to.data() + a * K;
           if (column[i] >= 0)
             g[column[i]] += gi;
           else
             for (int z = 0; z < K; ++z)
               g[z] += gi * J[i * K + z];
         }
+    };
+    r.value = value;
+    r.value_plus = value_plus;
+    if (with_positive_part)
+      chain_gradient(grad_plus, r.gradient_plus);
+    r.gradient.resize(ns * K);
+    if (!with_hessian)
+    {
+      chain_gradient(grad, r.gradient);
       continue;
     }
     r.hessian.resize(ns * K * K);
@@ -527,14 +557,23 @@ current_pair_gaps(const FacetSurface& slave,
   out.value.assign(P * ns, 0.0);
   out.gradient.assign(P * ns * Kw, 0.0);
   out.hessian.assign(with_hessian ? P * ns * Kw * Kw : 0, 0.0);
+  out.value_plus.assign(with_positive_part ? P * ns : 0, 0.0);
+  out.gradient_plus.assign(with_positive_part ? P * ns * Kw : 0, 0.0);
   for (std::size_t p = 0; p < P; ++p)
   {
     const PairResult& r = results[p];
     const std::size_t K = r.nodes.size() * gdim;
     std::copy(r.nodes.begin(), r.nodes.end(), out.nodes.begin() + p * width);
     std::copy(r.value.begin(), r.value.end(), out.value.begin() + p * ns);
+    std::copy(r.value_plus.begin(),
+              r.value_plus.end(),
+              out.value_plus.begin() + p * ns);
     for (int a = 0; a < ns; ++a)
     {
+      if (with_positive_part)
+        std::copy_n(r.gradient_plus.begin() + a * K,
+                    K,
+                    out.gradient_plus.begin() + (p * ns + a) * Kw);
       std::copy_n(r.gradient.begin() + a * K,
                   K,
                   out.gradient.begin() + (p * ns + a) * Kw);

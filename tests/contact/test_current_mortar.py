@@ -11,35 +11,10 @@ from dolfinx_mortar import ContactProblem
 from support.jacobian_check import (convergence_order, energy_gradient_error, jacobian_error,
                                     newton_history)
 from support import load_demo
-from support.scenes import LOCAL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks
+from support.scenes import (LOCAL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks,
+                            sheared_blocks, sheared_boxes)
 
 DUAL = ("LcLS*", "LcLS")
-
-
-def _sheared_blocks(kind: str, scaling: str = "consistent", degree: int = 1,
-                    comm=MPI.COMM_WORLD) -> ContactProblem:
-    """The patch-test blocks, the upper one tilted, slid and bent into the lower
-    one, the lower one waved: part of the interface in contact, every pair
-    moved by a fair part of an element from where it started."""
-    demo = load_demo("patch_test")
-    domain, tags = demo.build_mesh(2, 0.09, 0.14, degree, comm)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", degree))
-    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
-                             nu=0.3, kind=kind, penalty=1e3, scaling=scaling,
-                             basis_configuration="current",
-                             fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
-                             tractions={demo.TOP: [0.0, -0.01]})
-    problem.set_load(1.0)
-    tdim = domain.topology.dim
-    cells = np.arange(domain.topology.index_map(tdim).size_local, dtype=np.int32)
-    midpoints = mesh.compute_midpoints(domain, tdim, cells)[:, 1]
-    problem.u.interpolate(lambda x: np.vstack([0.01 * x[1] + 0.03 * x[0] ** 2,
-                                               -0.002 * (x[0] - 0.4) + 0.004 * x[0] ** 2]),
-                          cells=cells[midpoints > 0])
-    problem.u.interpolate(lambda x: np.vstack([0.004 * x[0] ** 2, 0.003 * np.sin(3 * x[0])]),
-                          cells=cells[midpoints < 0])
-    problem.u.x.scatter_forward()
-    return problem
 
 
 @pytest.mark.parametrize("degree", [1, 2])
@@ -48,7 +23,7 @@ def test_differentiable_gaps_equal_the_kernels(kind, degree):
     """The Jet computation repeats the C++ kernel step by step: same ∫ φ_A d per pair."""
     if degree == 2 and kind in DUAL:
         pytest.skip("dual kinds need P1 lines in the current configuration (tested below)")
-    problem = _sheared_blocks(kind, degree=degree)
+    problem = sheared_blocks(kind, degree=degree)
     state = problem.contact.evaluate()
     model = problem.gap_model
     kernel = (model.coupling.raw_pairs[2] @ model.C)[state.data.gap_data["pairs"]]
@@ -66,7 +41,7 @@ def test_differentiable_gaps_equal_the_kernels(kind, degree):
 @pytest.mark.parametrize("scaling", ["consistent", "seed"])
 @pytest.mark.parametrize("kind", LOCAL_KINDS)
 def test_current_mortar_residual_is_the_gradient_and_the_jacobian_is_exact(kind, scaling):
-    problem = _sheared_blocks(kind, scaling)
+    problem = sheared_blocks(kind, scaling)
     assert energy_gradient_error(problem) < 1e-8
     assert jacobian_error(problem) < 1e-8
 
@@ -74,23 +49,23 @@ def test_current_mortar_residual_is_the_gradient_and_the_jacobian_is_exact(kind,
 @pytest.mark.parametrize("kind", ["LmLS", "LmLS*"])
 def test_current_mortar_jacobian_is_exact_on_p2_lines(kind):
     """Curved facets: split into flat pieces, points mapped back by Newton."""
-    problem = _sheared_blocks(kind, degree=2)
+    problem = sheared_blocks(kind, degree=2)
     assert jacobian_error(problem) < 1e-8
 
 
 def test_missing_the_normal_linearization_is_detected():
     """The check above can fail: drop what the averaged normals contribute
     through the neighbouring slave cells' nodes, and it does."""
-    problem = _sheared_blocks("LmLS*")
+    problem = sheared_blocks("LmLS*")
     model = problem.gap_model
     exact = model.pair_derivatives
     # the same direction both times (fixed seeds): only the normals' terms differ
     exact_error = energy_gradient_error(problem)
 
-    def frozen_normals(u_nodes, coupling, which=None, with_hessian=True):
+    def frozen_normals(u_nodes, coupling, which=None, with_hessian=True, **options):
         """Neighbour nodes held at their values: the normals lose part of their
         derivatives (the slave cell's own and the master's nodes keep theirs)."""
-        r = dict(exact(u_nodes, coupling, which, with_hessian))
+        r = dict(exact(u_nodes, coupling, which, with_hessian, **options))
         ns, nm, gdim = model.slave.cells.shape[1], 2, 2
         nodes = r["nodes"]
         neighbour = np.zeros(nodes.shape, dtype=bool)
@@ -189,37 +164,12 @@ def test_current_mortar_same_figures_on_one_and_all_ranks():
                                                      make_problem)
 
 
-def _sheared_boxes(kind: str, scaling: str = "consistent") -> ContactProblem:
-    """The 3D patch-test boxes (coarse), bent, twisted and slid into each other."""
-    demo = load_demo("patch_test")
-    domain, tags = demo.build_mesh(3, 0.25, 0.35, 1, MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
-    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
-                             nu=0.3, kind=kind, penalty=1e3, scaling=scaling,
-                             basis_configuration="current",
-                             fixed={demo.SYM_X: {0: 0.0}, demo.SYM_Y: {1: 0.0},
-                                    demo.BOTTOM: {2: 0.0}},
-                             tractions={demo.TOP: [0.0, 0.0, -0.01]})
-    problem.set_load(1.0)
-    cells = np.arange(domain.topology.index_map(3).size_local, dtype=np.int32)
-    height = mesh.compute_midpoints(domain, 3, cells)[:, 2]
-    problem.u.interpolate(lambda x: np.vstack([0.01 * x[2] + 0.03 * x[0] ** 2,
-                                               0.02 * x[0] * x[1],
-                                               -0.002 * (x[0] - 0.4) + 0.004 * x[1] ** 2]),
-                          cells=cells[height > 0])
-    problem.u.interpolate(lambda x: np.vstack([0.004 * x[0] ** 2, 0.003 * x[1] ** 2,
-                                               0.003 * np.sin(3 * x[0]) * np.cos(2 * x[1])]),
-                          cells=cells[height < 0])
-    problem.u.x.scatter_forward()
-    return problem
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("kind, scaling", [("LmLS", "consistent"), ("LcLS*", "seed")])
 def test_current_mortar_3d_is_the_kernel_and_its_exact_derivatives(kind, scaling):
     """P1 triangles: clipping in Jet arithmetic equals the kernel; the residual is
     ∂Π/∂u and the Jacobian its Hessian."""
-    problem = _sheared_boxes(kind, scaling)
+    problem = sheared_boxes(kind, scaling)
     state = problem.contact.evaluate()
     model = problem.gap_model
     kernel = (model.coupling.raw_pairs[2] @ model.C)[state.data.gap_data["pairs"]]

@@ -159,9 +159,6 @@ def test_current_configuration_reports_what_it_cannot_do():
     with pytest.raises(NotImplementedError, match="boundary modification"):
         ContactProblem(V, tags, 1, master_tag=2, kind="LcLS*", boundary_modification=True,
                        **common)
-    with pytest.raises(NotImplementedError, match="nodal active set"):
-        ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), kind="LcLS*",
-                       active_set="pointwise", **common)
     V2 = fem.VectorFunctionSpace(V.mesh, ("Lagrange", 2))
     with pytest.raises(NotImplementedError, match="P1 lines or triangles"):
         ContactProblem(V2, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), kind="LcLS*",

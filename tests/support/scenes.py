@@ -1,8 +1,9 @@
 """Small contact scenes shared by tests of several layers (public API only)."""
 from __future__ import annotations
 
+import numpy as np
 import pytest
-from dolfinx import fem
+from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactProblem
@@ -44,3 +45,61 @@ def assert_same_hertz2d_figures_on_one_and_all_ranks(argv: list, make_problem) -
         results.append(demo.contact_results(problem, ref))
     for key in ("p0", "a", "l2_error", "contact_force"):
         assert results[0][key] == pytest.approx(results[1][key], rel=1e-8), key
+
+
+def sheared_blocks(kind: str, scaling: str = "consistent", degree: int = 1,
+                   comm=MPI.COMM_WORLD, active_set: str = "nodal",
+                   push: float = 0.0, mesh_and_tags=None) -> ContactProblem:
+    """The 2D patch-test blocks in the current configuration, the upper one
+    tilted, slid and bent into the lower one (and lowered by ``push`` more),
+    the lower one waved: part of the interface in contact, every pair moved by
+    a fair part of an element from where it started. ``mesh_and_tags``: the
+    mesh of another such problem (``(problem.mesh, problem.facet_tags)``), so
+    that two problems share dofs."""
+    demo = load_demo("patch_test")
+    domain, tags = mesh_and_tags or demo.build_mesh(2, 0.09, 0.14, degree, comm)
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", degree))
+    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
+                             nu=0.3, kind=kind, penalty=1e3, scaling=scaling,
+                             basis_configuration="current", active_set=active_set,
+                             fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
+                             tractions={demo.TOP: [0.0, -0.01]})
+    problem.set_load(1.0)
+    tdim = domain.topology.dim
+    cells = np.arange(domain.topology.index_map(tdim).size_local, dtype=np.int32)
+    midpoints = mesh.compute_midpoints(domain, tdim, cells)[:, 1]
+    problem.u.interpolate(lambda x: np.vstack([0.01 * x[1] + 0.03 * x[0] ** 2,
+                                               -0.002 * (x[0] - 0.4) + 0.004 * x[0] ** 2
+                                               - push]),
+                          cells=cells[midpoints > 0])
+    problem.u.interpolate(lambda x: np.vstack([0.004 * x[0] ** 2, 0.003 * np.sin(3 * x[0])]),
+                          cells=cells[midpoints < 0])
+    problem.u.x.scatter_forward()
+    return problem
+
+
+def sheared_boxes(kind: str, scaling: str = "consistent",
+                  active_set: str = "nodal") -> ContactProblem:
+    """The 3D patch-test boxes (coarse) in the current configuration, bent,
+    twisted and slid into each other."""
+    demo = load_demo("patch_test")
+    domain, tags = demo.build_mesh(3, 0.25, 0.35, 1, MPI.COMM_WORLD)
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
+                             nu=0.3, kind=kind, penalty=1e3, scaling=scaling,
+                             basis_configuration="current", active_set=active_set,
+                             fixed={demo.SYM_X: {0: 0.0}, demo.SYM_Y: {1: 0.0},
+                                    demo.BOTTOM: {2: 0.0}},
+                             tractions={demo.TOP: [0.0, 0.0, -0.01]})
+    problem.set_load(1.0)
+    cells = np.arange(domain.topology.index_map(3).size_local, dtype=np.int32)
+    height = mesh.compute_midpoints(domain, 3, cells)[:, 2]
+    problem.u.interpolate(lambda x: np.vstack([0.01 * x[2] + 0.03 * x[0] ** 2,
+                                               0.02 * x[0] * x[1],
+                                               -0.002 * (x[0] - 0.4) + 0.004 * x[1] ** 2]),
+                          cells=cells[height > 0])
+    problem.u.interpolate(lambda x: np.vstack([0.004 * x[0] ** 2, 0.003 * x[1] ** 2,
+                                               0.003 * np.sin(3 * x[0]) * np.cos(2 * x[1])]),
+                          cells=cells[height < 0])
+    problem.u.x.scatter_forward()
+    return problem

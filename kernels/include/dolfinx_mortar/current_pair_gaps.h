@@ -25,6 +25,10 @@ struct PairGapDerivatives
   std::vector<double> value;    ///< (pairs, ns)
   std::vector<double> gradient; ///< (pairs, ns, num_nodes·gdim)
   std::vector<double> hessian; ///< (pairs, ns, num_nodes·gdim, num_nodes·gdim)
+  /// (pairs, ns): c⁺_A = ∫ N_A ⟨d⟩, the pointwise active set's integrals
+  /// (empty unless asked for)
+  std::vector<double> value_plus;
+  std::vector<double> gradient_plus;   ///< (pairs, ns, num_nodes·gdim)
   std::int64_t failed_projections = 0; ///< quadrature points skipped
 };
 
@@ -61,6 +65,8 @@ averaged_normal_derivatives(const FacetSurface& s,
 /// the values' segmentation used)
 /// @param[in] with_hessian Also the Hessians (else `hessian` is empty and
 /// the gradients cost a fraction: a residual needs no Hessian)
+/// @param[in] with_positive_part Also c⁺_A = ∫ N_A ⟨d⟩ with its gradient
+/// (the pointwise active set), from the same points
 /// @throws std::invalid_argument for element combinations without an
 /// instantiation (3D quadratic facets)
 PairGapDerivatives
@@ -73,6 +79,7 @@ current_pair_gaps(const FacetSurface& slave,
                   std::span<const double> weights,
                   double zero,
                   bool opposing_normals_only,
-                  bool with_hessian = true);
+                  bool with_hessian = true,
+                  bool with_positive_part = false);
 
 } // namespace dolfinx_mortar
