@@ -108,7 +108,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
             master.facet_type, master.x, master.cells, master.global_ids.astype(np.int64),
             pairs.astype(np.int32), self.segment_points, self.segment_weights,
             coupling.zero_length, with_hessian=with_hessian,
-            with_positive_part=with_positive_part)
+            with_positive_part=with_positive_part, axisymmetric=slave.axisymmetric)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:

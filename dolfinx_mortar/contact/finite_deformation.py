@@ -131,6 +131,12 @@ class CurrentSurfaceGap(GapModelBase):
         if ref.transform is not None:
             raise NotImplementedError("basis_configuration='current' with the transformed "
                                       "quadratic basis is not implemented")
+        if slave.axisymmetric and self.kind in DUAL_KINDS:
+            raise NotImplementedError(
+                f"basis_configuration='current' with axisymmetric=True and "
+                f"{kind_name(self.kind)}: under 2πr ds the dual coefficients (L^e)⁻¹W^e "
+                "change with u_r and their derivatives are not implemented; use LmLS or "
+                "LmLS*, or 'initial'/'previous'")
         X, self.wq = basix.make_quadrature(ref.cell_type, quadrature_degree or 2 * ref.degree + 2)
         self.N, self.dN = ref.tabulate(X, transformed=False)       # (q, nd), (q, tdim, nd)
         if self.kind in DUAL_KINDS:
@@ -174,7 +180,24 @@ class CurrentSurfaceGap(GapModelBase):
         dJ = np.einsum("cqia,qab->cqbi", dJdF, self.dN)             # (c, q, nd, gdim)
         d2J = np.einsum("nqiajc,qab,qce->nqbiej", d2JdF, self.dN, self.dN)
         xq = np.einsum("qb,cbi->cqi", self.N, x)
+        if self.slave.axisymmetric:
+            J, dJ, d2J = self._swept(J, dJ, d2J, xq)
         return {"J": J, "dJ": dJ, "d2J": d2J, "x": xq}
+
+    def _swept(self, J: FloatArray, dJ: FloatArray, d2J: FloatArray, xq: FloatArray
+               ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The measure of an (r, z) meridian's surface of revolution, ``J·2πr``
+        with ``r = Σ_b N_b x_b,r`` at each point, and its derivatives (r
+        clamped at 0 as in :meth:`LagrangeSurface.radial_factor`: an axis node
+        may sit at −1e-17)."""
+        R = 2 * np.pi * np.maximum(xq[..., 0], 0.0)                 # (c, q)
+        dR = np.zeros(dJ.shape[1:])                                 # (q, nd, gdim)
+        dR[..., 0] = 2 * np.pi * self.N
+        d2J_swept = (d2J * R[..., None, None, None, None]
+                     + np.einsum("cqbi,qej->cqbiej", dJ, dR)
+                     + np.einsum("qbi,cqej->cqbiej", dR, dJ))
+        dJ_swept = dJ * R[..., None, None] + J[..., None, None] * dR[None]
+        return J * R, dJ_swept, d2J_swept
 
     def _nodal_coefficients(self, g: FloatArray, W: FloatArray, active: FloatArray):
         """∂F/∂ĝ, ∂F/∂W and the second derivatives of F = (ε/2) W^m ⟨ĝ W^{−k}⟩²."""

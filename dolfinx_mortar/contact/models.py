@@ -69,11 +69,6 @@ class ContactOptions:
         if basis_configuration == "current" and boundary_modification:
             raise NotImplementedError("basis_configuration='current' with the boundary "
                                       "modification is not implemented")
-        if basis_configuration == "current" and axisymmetric:
-            raise NotImplementedError("basis_configuration='current' with axisymmetric=True: "
-                                      "the measure 2πr ds moves with u_r and its "
-                                      "linearization is not implemented; use 'initial' or "
-                                      "'previous'")
         if boundary_modification and not (elastic_master and kind in DUAL_KINDS):
             raise ValueError("the consistent boundary modification applies to the dual kinds "
                              "(LcLS*, LcLS) with an elastic master (master_tag)")

@@ -380,7 +380,8 @@ PYBIND11_MODULE(_kernels, m)
        double zero,
        bool opposing_normals_only,
        bool with_hessian,
-       bool with_positive_part)
+       bool with_positive_part,
+       bool axisymmetric)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
@@ -398,7 +399,8 @@ PYBIND11_MODULE(_kernels, m)
           zero,
           opposing_normals_only,
           with_hessian,
-          with_positive_part);
+          with_positive_part,
+          axisymmetric);
       }
       const auto np = static_cast<py::ssize_t>(pairs.size() / 2);
       const py::ssize_t ns = cs.shape(1);
@@ -431,6 +433,7 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("opposing_normals_only") = true,
     py::arg("with_hessian") = true,
     py::arg("with_positive_part") = false,
+    py::arg("axisymmetric") = false,
     "Current-configuration mortar gaps of cell pairs with exact gradients "
     "and Hessians (and, with_positive_part, the pointwise active set's "
     "integrals of <d> with their gradients)");

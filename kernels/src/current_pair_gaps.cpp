@@ -256,6 +256,7 @@ inner_pair_derivatives(FacetType slave_type,
                        std::span<const double> weights,
                        double zero,
                        bool opposing_normals_only,
+                       bool axisymmetric,
                        std::span<double> value,
                        std::span<double> grad,
                        std::span<double> hess,
@@ -296,7 +297,7 @@ inner_pair_derivatives(FacetType slave_type,
                                                 weights,
                                                 zero,
                                                 opposing_normals_only,
-                                                false,
+                                                axisymmetric,
                                                 accumulate);
   for (int a = 0; a < ns; ++a)
   {
@@ -322,6 +323,7 @@ using InnerFunction = std::int64_t (*)(FacetType,
                                        std::span<const double>,
                                        std::span<const double>,
                                        double,
+                                       bool,
                                        bool,
                                        std::span<double>,
                                        std::span<double>,
@@ -380,13 +382,17 @@ current_pair_gaps(const FacetSurface& slave,
                   double zero,
                   bool opposing_normals_only,
                   bool with_hessian,
-                  bool with_positive_part)
+                  bool with_positive_part,
+                  bool axisymmetric)
 {
   slave.check();
   master.check();
   if (slave.gdim != master.gdim)
     throw std::invalid_argument("slave and master surfaces differ in gdim");
   const int gdim = slave.gdim;
+  if (axisymmetric and gdim != 2)
+    throw std::invalid_argument(
+      "axisymmetric surfaces are (r, z) lines: gdim must be 2");
   if (slave_ids.size() != slave.x.size() / gdim or
       master_ids.size() != master.x.size() / gdim)
     throw std::invalid_argument("one id per surface node expected");
@@ -468,6 +474,7 @@ current_pair_gaps(const FacetSurface& slave,
                                     weights,
                                     zero,
                                     opposing_normals_only,
+                                    axisymmetric,
                                     value,
                                     grad,
                                     hess,

@@ -16,7 +16,8 @@ from mpi4py import MPI
 
 from dolfinx_mortar import KIND_NAMES, ContactProblem, ContactTerm, RigidPlane, RigidSphere
 from support import load_demo
-from support.jacobian_check import has_gaps_of_both_signs, jacobian_error, newton_step_error
+from support.jacobian_check import (energy_gradient_error, has_gaps_of_both_signs,
+                                    jacobian_error, newton_step_error)
 from support.meshes import rectangle
 from support.scenes import block_on_plane
 
@@ -106,14 +107,16 @@ def test_cylinder_on_a_rigid_plane_has_the_exact_axisymmetric_solution(kind):
     assert problem.contact_force()[1] == pytest.approx(P * np.pi, rel=1e-8)
 
 
-def pressed_cylinder(obstacle, kind: str, depth: float, active_set: str = "nodal"):
+def pressed_cylinder(obstacle, kind: str, depth: float, active_set: str = "nodal",
+                     basis_configuration: str = "initial"):
     """A coarse cylinder against ``obstacle`` at full load, deformed so that its
     bottom penetrates by ``depth`` on the axis and less outwards (the contact
     ends inside the slave surface); returns the problem."""
     V, tags = block_on_plane(n=(6, 3))
     problem = ContactProblem(V, tags, BOTTOM, obstacle=obstacle, E=E, nu=NU, kind=kind,
                              penalty=50.0, fixed={AXIS: {0: 0.0}}, tractions={TOP: [0.0, -P]},
-                             active_set=active_set, axisymmetric=True)
+                             active_set=active_set, basis_configuration=basis_configuration,
+                             axisymmetric=True)
     problem.set_load(1.0)
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[0] * x[1],
                                                -depth + 0.003 * x[0] ** 2]))
@@ -142,12 +145,16 @@ def test_gls_newton_step_inverts_the_residual_derivative(kind, active_set):
     assert newton_step_error(problem) < 1e-6
 
 
-@pytest.mark.parametrize("kind", ["LmLS*", "LcLS"])
-def test_jacobian_matches_finite_differences_between_two_bodies(kind):
+@pytest.mark.parametrize("kind, active_set, configuration",
+                         [("LmLS*", "pointwise", "initial"), ("LcLS", "nodal", "initial"),
+                          ("LmLS*", "nodal", "current"), ("LmLS", "pointwise", "current")])
+def test_jacobian_matches_finite_differences_between_two_bodies(kind, active_set, configuration):
+    """"current": the segments' 2πr weights through the Jet kernel, the master
+    and the slave moving with u_r."""
     demo, V, tags, fine = two_cylinders("finer-slave")
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=E, nu=NU,
-                             kind=kind, penalty=1e2, active_set="pointwise"
-                             if kind == "LmLS*" else "nodal",
+                             kind=kind, penalty=1e2, active_set=active_set,
+                             basis_configuration=configuration,
                              fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
                              tractions={demo.TOP: [0.0, -P]}, axisymmetric=True)
     problem.set_load(1.0)
@@ -163,13 +170,44 @@ def test_jacobian_matches_finite_differences_between_two_bodies(kind):
     assert jacobian_error(problem) < 1e-7
 
 
+@pytest.mark.parametrize("active_set", ["nodal", "pointwise"])
+@pytest.mark.parametrize("kind", ["LmLS", "LmLS*"])
+@pytest.mark.parametrize("obstacle", ["plane", "sphere"])
+def test_current_configuration_jacobian_matches_finite_differences(obstacle, kind, active_set):
+    """Bases on the current surface of revolution: the measure J·2πr moves with
+    u_r, and W, ĝ and their derivatives with it."""
+    ob = (RigidPlane([0, -0.0005], [0, 1]) if obstacle == "plane"
+          else RigidSphere([0.0, -2.0], 2.01))
+    problem = pressed_cylinder(ob, kind, depth=0.002, active_set=active_set,
+                               basis_configuration="current")
+    if active_set == "nodal":
+        assert energy_gradient_error(problem) < 1e-6
+    assert jacobian_error(problem) < 1e-7
+
+
+def test_current_configuration_measure_is_the_swept_area():
+    """Σ_A W_A on the current surface is the area its meridian sweeps, 2π ∫ r ds
+    (the bottom disk of a cylinder stretched radially by 1%: π·1.01²)."""
+    V, tags = block_on_plane(n=(6, 3))
+    problem = ContactProblem(V, tags, BOTTOM, obstacle=RigidPlane([0, -1.0], [0, 1]), E=E,
+                             nu=NU, kind="LmLS", penalty=50.0, fixed={AXIS: {0: 0.0}},
+                             basis_configuration="current", axisymmetric=True)
+    problem.u.interpolate(lambda x: np.vstack([0.01 * x[0], 0.0 * x[1]]))
+    problem.u.x.scatter_forward()
+    problem.contact.evaluate()
+    W = problem.gap_model.lumped_weights
+    n = problem.slave.layout.num_owned
+    total = problem.mesh.comm.allreduce(float(np.sum(W[:n])))
+    assert abs(total - np.pi * 1.01 ** 2) <= 1e-12 * np.pi
+
+
 def test_bad_axisymmetric_input_is_named():
     V, tags = block_on_plane(n=(4, 2))
     u = fem.Function(V)
     plane = RigidPlane([0, 0], [0, 1])
-    with pytest.raises(NotImplementedError, match="axisymmetric"):
+    with pytest.raises(NotImplementedError, match="dual coefficients"):
         ContactTerm(u, tags, BOTTOM, obstacle=plane, penalty=1.0, axisymmetric=True,
-                    basis_configuration="current")
+                    kind="LcLS*", basis_configuration="current")
     # the mesh on the wrong side of the axis
     domain, tags_left = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (4, 2), bottom=1, top=2, left=3)
     domain.geometry.x[:, 0] -= 0.5

@@ -67,6 +67,8 @@ averaged_normal_derivatives(const FacetSurface& s,
 /// the gradients cost a fraction: a residual needs no Hessian)
 /// @param[in] with_positive_part Also c⁺_A = ∫ N_A ⟨d⟩ with its gradient
 /// (the pointwise active set), from the same points
+/// @param[in] axisymmetric The surfaces are (r, z) meridians: every weight
+/// carries 2πr at the slave point, and its derivatives with it
 /// @throws std::invalid_argument for element combinations without an
 /// instantiation (3D quadratic facets)
 PairGapDerivatives
@@ -80,6 +82,7 @@ current_pair_gaps(const FacetSurface& slave,
                   double zero,
                   bool opposing_normals_only,
                   bool with_hessian = true,
-                  bool with_positive_part = false);
+                  bool with_positive_part = false,
+                  bool axisymmetric = false);
 
 } // namespace dolfinx_mortar
