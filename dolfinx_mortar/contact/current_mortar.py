@@ -113,7 +113,6 @@ class CurrentMortarGap(CurrentSurfaceGap):
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
         slave, layout = self.slave, self.slave.layout
-        gdim = slave.gdim
         # the pairs are found again at every evaluation, and only those near
         # contact matter: each facet searches two of its own diameters
         # (unless the user set a radius), not the largest facet's

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from dolfinx import fem, mesh
+from dolfinx import fem
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactProblem
