@@ -71,6 +71,12 @@ class MortarBasis:
         self.element_weights = _kernels.element_integrals(tab.phi, tab.weights)
         #: W_A = ∫ N_A dA at owned and ghost functions
         self.lumped_weights = self.layout.sum_at_functions(self.cells, self.element_weights)
+        #: each function's own length, (∫ N_A ds)^(1/tdim) with the facets'
+        #: measure alone (no 2πr on an axisymmetric surface): the one scale of
+        #: the geometric decisions at a node (near contact, stiffened nodes)
+        self.node_lengths = np.power(np.maximum(self.layout.sum_at_functions(
+            self.cells, _kernels.element_integrals(tab.phi, tab.ds_weights)), 0.0),
+            1.0 / surface.tdim)
         nodal_at_cells = self.lumped_weights[self.cells]
         gdim = tab.points.shape[2]
         scale = length_scale(tab.points.reshape(-1, gdim), self.layout.comm)

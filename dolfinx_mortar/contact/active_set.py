@@ -37,8 +37,7 @@ def stiffened_nodes(model: GapModel, state: ContactState) -> FloatArray:
     active = covered & (state.gaps >= 0)
     n = slave.layout.num_owned
     if comm.allreduce(int(np.sum(active[:n]))) == 0:
-        length = np.power(np.maximum(model.basis.lumped_weights, 0.0), 1.0 / slave.tdim)
-        active = covered & (state.gaps >= -NEAR_CONTACT * length)
+        active = covered & (state.gaps >= -NEAR_CONTACT * model.basis.node_lengths)
     return active.astype(np.float64)
 
 

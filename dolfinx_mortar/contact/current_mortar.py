@@ -173,9 +173,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
         two element lengths were kept too: 5-10 times the pairs on Hertz 3D,
         for no entry that is used.)"""
         Wsafe = np.where(W > 0, W, 1.0)
-        length = Wsafe ** (1.0 / self.slave.tdim)
         y = g * Wsafe ** (-self.k)
-        return y >= -2 * NEAR_CONTACT * length
+        return y >= -2 * NEAR_CONTACT * self.basis.node_lengths
 
     def _variable_dofs(self, nodes: IntArray, num_pairs: int) -> IntArray:
         """Global dofs of the kernel's pair variables (``nodes``: pairs × variable
