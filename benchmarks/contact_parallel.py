@@ -1,0 +1,131 @@
+"""Where the contact work goes on each MPI rank: Hertz 3D with two bodies.
+
+Runs the scene of ``demos/hertz3d.py --obstacle elastic`` (LcLS*, nodal
+active set, 3 load steps, the iterative linear solver) once and prints, for
+every rank, what it holds of the contact (owned slave nodes, slave facets,
+candidate and segmented pairs) and how long its contact phases took: the
+master surface gathered and the normals averaged, the box search, the
+segmentation, the rest of the setup (bases, the gap operator G), the residual
+evaluations and the Jacobian assembly, next to its bulk assembly. A rank that
+holds the contact zone alone shows here as the one whose contact time does
+not fall with the rank count.
+
+    OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/contact_parallel.py --refine 2
+    mpirun -n 2 /usr/bin/python3 benchmarks/contact_parallel.py --refine 2 [--profile]
+
+Writes ``contact_parallel_n{ranks}.csv`` into ``--out`` (default
+``benchmarks/results/``); ``--profile`` also writes each rank's cProfile of
+the solve (cumulative, the 40 most expensive) as
+``contact_parallel_n{ranks}_rank{r}.txt``.
+"""
+from __future__ import annotations
+
+import argparse
+import cProfile
+import io
+import os
+import pstats
+import time
+from pathlib import Path
+from typing import Optional, Sequence
+
+import numpy as np
+from mpi4py import MPI
+
+from dolfinx_mortar.demo_support.scripts import load_demo
+from dolfinx_mortar.io.output import write_csv
+
+HERE = Path(__file__).resolve().parent
+PHASES = ("normals_and_gather", "search", "segmentation", "setup_rest", "residual",
+          "jacobian", "contact_total", "bulk", "wall")
+COLUMNS = ("rank", "owned_slave_nodes", "slave_facets", "candidates", "pairs") + PHASES
+
+
+def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--refine", type=float, default=1.0, help="hertz3d --refine (1)")
+    parser.add_argument("--penalty", type=float, default=1e3, help="ε as a multiple of E/h")
+    parser.add_argument("--linear-solver", default="iterative",
+                        choices=("iterative", "direct"))
+    parser.add_argument("--profile", action="store_true",
+                        help="also write each rank's cProfile of the solve")
+    parser.add_argument("--out", default=str(HERE / "results"))
+    return parser.parse_args(argv)
+
+
+def rank_row(problem, wall: float) -> dict:
+    """This rank's contact holdings and phase times (s)."""
+    contact = problem.contact
+    coupling = getattr(contact.model, "coupling", None)
+    t = problem.timings
+    split = dict(coupling.timings) if coupling is not None else {}
+    setup = t.get("contact_setup", 0.0)
+    row = {"rank": problem.mesh.comm.rank,
+           "owned_slave_nodes": int(np.count_nonzero(
+               np.unique(problem.slave.cells) < problem.slave.layout.num_owned)),
+           "slave_facets": len(problem.slave.cells),
+           "candidates": getattr(coupling, "num_candidates", 0),
+           "pairs": len(coupling.pairs) if coupling is not None else 0,
+           "normals_and_gather": split.get("normals_and_gather", 0.0),
+           "search": split.get("search", 0.0),
+           "segmentation": split.get("segmentation", 0.0),
+           "setup_rest": max(setup - sum(split.values()), 0.0),
+           "residual": t.get("contact_residual", 0.0),
+           "jacobian": t.get("contact_jacobian", 0.0),
+           "bulk": t.get("bulk_residual", 0.0) + t.get("bulk_jacobian", 0.0),
+           "wall": wall}
+    row["contact_total"] = sum(v for k, v in t.items() if k.startswith("contact_"))
+    return row
+
+
+def table(rows: list[dict], load: float) -> str:
+    lines = [f"Hertz 3D two bodies, {len(rows)} rank(s); 1-minute load average before the "
+             f"run {load:.2f} on {os.cpu_count()} cores; times in s", "",
+             "| rank | owned slave nodes | slave facets | candidates | pairs | gather+normals "
+             "| search | segmentation | rest of setup | residuals | Jacobians | contact | bulk "
+             "| wall |", "|" + "---|" * 14]
+    for r in rows:
+        lines.append(
+            f"| {r['rank']} | {r['owned_slave_nodes']} | {r['slave_facets']} "
+            f"| {r['candidates']} | {r['pairs']} | {r['normals_and_gather']:.2f} "
+            f"| {r['search']:.2f} | {r['segmentation']:.2f} | {r['setup_rest']:.2f} "
+            f"| {r['residual']:.2f} | {r['jacobian']:.2f} | {r['contact_total']:.2f} "
+            f"| {r['bulk']:.2f} | {r['wall']:.1f} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
+    args = parse_args(argv)
+    comm = MPI.COMM_WORLD
+    load = os.getloadavg()[0]
+    demo = load_demo("hertz3d")
+    demo_args = demo.parse_args(["--obstacle", "elastic", "--refine", str(args.refine),
+                                 "--penalty", str(args.penalty),
+                                 "--linear-solver", args.linear_solver])
+    profiler = cProfile.Profile() if args.profile else None
+    comm.Barrier()
+    clock = time.perf_counter()
+    if profiler:
+        profiler.enable()
+    problem, _ = demo.build_problem(demo_args, comm)
+    problem.solve(load_steps=demo_args.load_steps)
+    if profiler:
+        profiler.disable()
+    wall = time.perf_counter() - clock
+    rows = comm.gather(rank_row(problem, wall))
+    out = Path(args.out)
+    stem = f"contact_parallel_n{comm.size}"
+    if profiler:
+        text = io.StringIO()
+        pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(40)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / f"{stem}_rank{comm.rank}.txt").write_text(text.getvalue())
+    if comm.rank == 0:
+        out.mkdir(parents=True, exist_ok=True)
+        write_csv(out / f"{stem}.csv", rows, COLUMNS)
+        print(table(rows, load))
+    return rows or []
+
+
+if __name__ == "__main__":
+    main()
