@@ -38,7 +38,8 @@ from dolfinx_mortar.io.output import write_csv
 HERE = Path(__file__).resolve().parent
 PHASES = ("normals_and_gather", "search", "segmentation", "setup_rest", "residual",
           "jacobian", "contact_total", "bulk", "wall")
-COLUMNS = ("rank", "owned_slave_nodes", "slave_facets", "candidates", "pairs") + PHASES
+COLUMNS = ("rank", "dofs", "newton", "krylov", "owned_slave_nodes", "slave_facets",
+           "candidates", "pairs") + PHASES
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
@@ -53,14 +54,18 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
-def rank_row(problem, wall: float) -> dict:
-    """This rank's contact holdings and phase times (s)."""
+def rank_row(problem, result, wall: float) -> dict:
+    """This rank's contact holdings and phase times (s), with the solve's size
+    and iteration counts."""
     contact = problem.contact
     coupling = getattr(contact.model, "coupling", None)
     t = problem.timings
     split = dict(coupling.timings) if coupling is not None else {}
     setup = t.get("contact_setup", 0.0)
+    V = problem.V
     row = {"rank": problem.mesh.comm.rank,
+           "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
+           "newton": result.newton_iterations, "krylov": result.linear_iterations,
            "owned_slave_nodes": int(np.count_nonzero(
                np.unique(problem.slave.cells) < problem.slave.layout.num_owned)),
            "slave_facets": len(problem.slave.cells),
@@ -79,8 +84,10 @@ def rank_row(problem, wall: float) -> dict:
 
 
 def table(rows: list[dict], load: float) -> str:
-    lines = [f"Hertz 3D two bodies, {len(rows)} rank(s); 1-minute load average before the "
-             f"run {load:.2f} on {os.cpu_count()} cores; times in s", "",
+    r0 = rows[0]
+    lines = [f"Hertz 3D two bodies, {r0['dofs']} dofs, {len(rows)} rank(s), "
+             f"{r0['newton']} Newton and {r0['krylov']} Krylov iterations; 1-minute load "
+             f"average before the run {load:.2f} on {os.cpu_count()} cores; times in s", "",
              "| rank | owned slave nodes | slave facets | candidates | pairs | gather+normals "
              "| search | segmentation | rest of setup | residuals | Jacobians | contact | bulk "
              "| wall |", "|" + "---|" * 14]
@@ -108,11 +115,11 @@ def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
     if profiler:
         profiler.enable()
     problem, _ = demo.build_problem(demo_args, comm)
-    problem.solve(load_steps=demo_args.load_steps)
+    result = problem.solve(load_steps=demo_args.load_steps)
     if profiler:
         profiler.disable()
     wall = time.perf_counter() - clock
-    rows = comm.gather(rank_row(problem, wall))
+    rows = comm.gather(rank_row(problem, result, wall))
     out = Path(args.out)
     stem = f"contact_parallel_n{comm.size}"
     if profiler:

@@ -90,8 +90,8 @@ class ContactTerm(ContactResults):
         near its far node reads a separation as a penetration (the dual
         functions are negative there).
     search_radius
-        How far apart slave and master facets may be and still be paired
-        (default the largest slave facet diameter).
+        How far along its normal a slave facet reaches for master facets to
+        pair with (default the largest slave facet diameter).
     axisymmetric
         The mesh is the (r, z) half-plane r ≥ 0 of a body of revolution (x the
         radius, y the axis): every contact integral carries 2πr, so that

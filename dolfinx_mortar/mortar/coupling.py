@@ -94,6 +94,40 @@ def averaged_nodal_normals(surface: LagrangeSurface, x: FloatArray) -> FloatArra
                      where=length[:, None] > 0)  # exactly 0 only on nodes of no cell
 
 
+def swept_facet_boxes(surface: LagrangeSurface, x: FloatArray, cells: npt.NDArray[np.int32],
+                      reach: float, diameters: FloatArray) -> FloatArray:
+    """Bounding boxes (cells, 6) of each facet swept ``reach`` both ways along
+    its own normal and enlarged by its own diameter, within the facet's box
+    enlarged by ``reach`` (the search before: it never finds a pair that
+    search did not).
+
+    The segmentation pairs a master facet with a slave facet when its
+    projection along the slave facet's normal overlaps it, at any distance:
+    the search decides the distance. A master point that projects onto an
+    affine facet from at most ``reach`` away lies in the prism of its nodes
+    ± reach·n, whose box this contains; the diameter covers curved facets'
+    turning normals. A box enlarged by ``reach`` in every direction, as
+    before, holds (reach/diameter)² times the candidates of a small facet
+    next to a large one: 16.2M candidates for 29.7k pairs on Hertz 3D at
+    311k dofs, 13 s of segmentation.
+    """
+    gdim = x.shape[1]
+    normals = _kernels.element_node_normals(surface.facet_type, x, cells)
+    normals = normals.reshape(len(cells), -1, gdim)
+    nodes = x[cells]                                             # (cells, nodes, gdim)
+    swept = np.concatenate([nodes - reach * normals, nodes + reach * normals], axis=1)
+    boxes = _kernels.facet_bounding_boxes(surface.facet_type, x, cells, 0.0)
+    margin = diameters[:, None]
+    boxes[:, :gdim] = np.minimum(boxes[:, :gdim], swept.min(axis=1)) - margin
+    boxes[:, 3:3 + gdim] = np.maximum(boxes[:, 3:3 + gdim], swept.max(axis=1)) + margin
+    boxes[:, gdim:3] -= margin                                   # 2D: z in [−d, d]
+    boxes[:, 3 + gdim:] += margin
+    isotropic = _kernels.facet_bounding_boxes(surface.facet_type, x, cells, reach)
+    boxes[:, :3] = np.maximum(boxes[:, :3], isotropic[:, :3])
+    boxes[:, 3:] = np.minimum(boxes[:, 3:], isotropic[:, 3:])
+    return boxes
+
+
 def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
     """All ranks' cells of a surface, with one copy of the nodes per cell.
 
@@ -136,8 +170,8 @@ class MortarCoupling:
         Nodal displacements (local nodes, gdim) giving the configuration;
         ``None`` means the surfaces' own coordinates.
     search_radius
-        How far apart facets may be and still be paired; default the largest
-        slave facet diameter.
+        How far along its normal a slave facet reaches for master facets;
+        default the largest slave facet diameter (:func:`swept_facet_boxes`).
     facet_search_factor
         Instead of one ``search_radius``, pair each slave facet with the master
         facets within this multiple of its own diameter. On a graded mesh the
@@ -206,8 +240,8 @@ class MortarCoupling:
         self.search_radius = float(search_radius)
         slave_cells = slave.cells.astype(np.int32)
         if facet_search_factor is None:
-            slave_boxes = _kernels.facet_bounding_boxes(slave.facet_type, xs, slave_cells,
-                                                        self.search_radius)
+            slave_boxes = swept_facet_boxes(slave, xs, slave_cells, self.search_radius,
+                                            diameters)
         else:
             if not (np.isfinite(facet_search_factor) and facet_search_factor > 0):
                 raise ValueError("facet_search_factor must be positive and finite, got "

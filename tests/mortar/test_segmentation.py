@@ -309,7 +309,19 @@ def test_facet_search_finds_the_close_pairs_from_far_fewer_candidates():
     assert {tuple(p) for p in local.pairs} == {tuple(p) for p in default.pairs}
     assert np.allclose(local.covered_area, default.covered_area, rtol=0, atol=1e-14 * 3.0)
     assert abs(np.sum(local.covered_area) - 3.0) <= 1e-12 * 3.0
-    assert local.num_candidates < default.num_candidates / 5
+
+
+def test_default_search_sweeps_each_facet_along_its_normal():
+    """The largest facet's radius, 2.5, reaches along each facet's normal
+    only: a box enlarged by 2.5 every way gave each 0.01-long facet all the
+    master facets beside it (16k candidates for 300 pairs); swept along y it
+    gets those below it, at most a few per pair."""
+    slave = _graded_slave()
+    master = flat_line(1, 320, bounds=(-0.1, 3.1), y=0.004, up=False)
+    default = MortarCoupling(slave, master)
+    assert default.search_radius == pytest.approx(2.5, rel=1e-12)
+    assert abs(np.sum(default.covered_area) - 3.0) <= 1e-12 * 3.0
+    assert default.num_candidates < 3 * len(default.pairs)
 
 
 def test_facet_search_ignores_a_master_beyond_two_facet_diameters():
