@@ -112,9 +112,8 @@ def swept_facet_boxes(surface: LagrangeSurface, x: FloatArray, cells: npt.NDArra
     311k dofs, 13 s of segmentation.
     """
     gdim = x.shape[1]
-    normals = _kernels.element_node_normals(surface.facet_type, x, cells)
-    normals = normals.reshape(len(cells), -1, gdim)
     nodes = x[cells]                                             # (cells, nodes, gdim)
+    normals = _kernels.element_node_normals(surface.facet_type, x, cells).reshape(nodes.shape)
     swept = np.concatenate([nodes - reach * normals, nodes + reach * normals], axis=1)
     boxes = _kernels.facet_bounding_boxes(surface.facet_type, x, cells, 0.0)
     margin = diameters[:, None]

@@ -333,3 +333,14 @@ def test_facet_search_ignores_a_master_beyond_two_facet_diameters():
     assert abs(np.sum(MortarCoupling(slave, master).covered_area) - 3.0) <= 1e-12 * 3.0
     with pytest.raises(ValueError, match="facet_search_factor"):
         MortarCoupling(slave, master, facet_search_factor=-1.0)
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+def test_swept_boxes_of_no_facets(degree):
+    """A rank may hold no slave facet (Hertz 3D on 2 ranks: all on one): no
+    boxes, no error (the other rank would wait in a collective)."""
+    from dolfinx_mortar.mortar.coupling import swept_facet_boxes
+    surface = flat_line(degree, 4)
+    cells = np.zeros((0, surface.cells.shape[1]), dtype=np.int32)
+    boxes = swept_facet_boxes(surface, surface.x, cells, 1.0, np.zeros(0))
+    assert boxes.shape == (0, 6)
