@@ -38,6 +38,14 @@ from dolfinx_mortar.io.output import write_csv
 HERE = Path(__file__).resolve().parent
 PHASES = ("normals_and_gather", "search", "segmentation", "setup_rest", "residual",
           "jacobian", "contact_total", "bulk", "wall")
+#: the printed table: title, row key, format
+TABLE = [("rank", "rank", "d"), ("owned slave nodes", "owned_slave_nodes", "d"),
+         ("slave facets", "slave_facets", "d"), ("candidates", "candidates", "d"),
+         ("pairs", "pairs", "d"), ("gather+normals", "normals_and_gather", ".2f"),
+         ("search", "search", ".2f"), ("segmentation", "segmentation", ".2f"),
+         ("rest of setup", "setup_rest", ".2f"), ("residuals", "residual", ".2f"),
+         ("Jacobians", "jacobian", ".2f"), ("contact", "contact_total", ".2f"),
+         ("bulk", "bulk", ".2f"), ("wall", "wall", ".1f")]
 COLUMNS = ("rank", "dofs", "newton", "krylov", "owned_slave_nodes", "slave_facets",
            "candidates", "pairs") + PHASES
 
@@ -88,23 +96,15 @@ def table(rows: list[dict], load: float) -> str:
     lines = [f"Hertz 3D two bodies, {r0['dofs']} dofs, {len(rows)} rank(s), "
              f"{r0['newton']} Newton and {r0['krylov']} Krylov iterations; 1-minute load "
              f"average before the run {load:.2f} on {os.cpu_count()} cores; times in s", "",
-             "| rank | owned slave nodes | slave facets | candidates | pairs | gather+normals "
-             "| search | segmentation | rest of setup | residuals | Jacobians | contact | bulk "
-             "| wall |", "|" + "---|" * 14]
-    for r in rows:
-        lines.append(
-            f"| {r['rank']} | {r['owned_slave_nodes']} | {r['slave_facets']} "
-            f"| {r['candidates']} | {r['pairs']} | {r['normals_and_gather']:.2f} "
-            f"| {r['search']:.2f} | {r['segmentation']:.2f} | {r['setup_rest']:.2f} "
-            f"| {r['residual']:.2f} | {r['jacobian']:.2f} | {r['contact_total']:.2f} "
-            f"| {r['bulk']:.2f} | {r['wall']:.1f} |")
+             "| " + " | ".join(title for title, _, _ in TABLE) + " |",
+             "|" + "---|" * len(TABLE)]
+    lines += ["| " + " | ".join(f"{r[key]:{spec}}" for _, key, spec in TABLE) + " |"
+              for r in rows]
     return "\n".join(lines) + "\n"
 
 
 def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
-    args = parse_args(argv)
-    comm = MPI.COMM_WORLD
-    load = os.getloadavg()[0]
+    args, comm, load = parse_args(argv), MPI.COMM_WORLD, os.getloadavg()[0]
     demo = load_demo("hertz3d")
     demo_args = demo.parse_args(["--obstacle", "elastic", "--refine", str(args.refine),
                                  "--penalty", str(args.penalty),
