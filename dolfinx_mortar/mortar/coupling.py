@@ -115,15 +115,13 @@ def swept_facet_boxes(surface: LagrangeSurface, x: FloatArray, cells: npt.NDArra
     nodes = x[cells]                                             # (cells, nodes, gdim)
     normals = _kernels.element_node_normals(surface.facet_type, x, cells).reshape(nodes.shape)
     swept = np.concatenate([nodes - reach * normals, nodes + reach * normals], axis=1)
-    boxes = _kernels.facet_bounding_boxes(surface.facet_type, x, cells, 0.0)
+    facet = _kernels.facet_bounding_boxes(surface.facet_type, x, cells, 0.0)
     margin = diameters[:, None]
-    boxes[:, :gdim] = np.minimum(boxes[:, :gdim], swept.min(axis=1)) - margin
-    boxes[:, 3:3 + gdim] = np.maximum(boxes[:, 3:3 + gdim], swept.max(axis=1)) + margin
-    boxes[:, gdim:3] -= margin                                   # 2D: z in [−d, d]
-    boxes[:, 3 + gdim:] += margin
-    isotropic = _kernels.facet_bounding_boxes(surface.facet_type, x, cells, reach)
-    boxes[:, :3] = np.maximum(boxes[:, :3], isotropic[:, :3])
-    boxes[:, 3:] = np.minimum(boxes[:, 3:], isotropic[:, 3:])
+    boxes = facet.copy()
+    boxes[:, :gdim] = np.minimum(boxes[:, :gdim], swept.min(axis=1))
+    boxes[:, 3:3 + gdim] = np.maximum(boxes[:, 3:3 + gdim], swept.max(axis=1))
+    boxes[:, :3] = np.maximum(boxes[:, :3] - margin, facet[:, :3] - reach)
+    boxes[:, 3:] = np.minimum(boxes[:, 3:] + margin, facet[:, 3:] + reach)
     return boxes
 
 
