@@ -39,7 +39,7 @@ from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.pointwise import MortarPointGaps, obstacle_positive_gaps
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
-from dolfinx_mortar.contact.sparse_products import transpose_mat_mult
+from dolfinx_mortar.contact.sparse_products import TransposeProduct, transpose_mat_mult
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -95,6 +95,7 @@ class GapModelBase:
         C = self.basis.coefficients
         #: M̄ = N_std C_std on each slave cell (N_std: the displacement's basis)
         self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
+        self._stiffness_product = TransposeProduct()
 
     @property
     def lumped_weights(self) -> FloatArray:
@@ -158,8 +159,9 @@ class GapModelBase:
             G_right, weights = state.G_plus, self.weights
         SG = G_right.copy()
         SG.diagonalScale(self.slave.layout.vector(weights), None)
-        K = transpose_mat_mult(state.G, SG)
+        K = self._stiffness_product(state.G, SG)
         if state.K_curv is not None:
+            K = K.copy()  # the product's own matrix keeps its pattern for the next reuse
             K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return K
 

@@ -25,6 +25,48 @@ def transpose_mat_mult(A: PETSc.Mat, B: PETSc.Mat) -> PETSc.Mat:
     return product
 
 
+def _pattern(M: PETSc.Mat) -> tuple[np.ndarray, np.ndarray]:
+    rows, cols, _ = M.getValuesCSR()
+    return rows.copy(), cols.copy()
+
+
+class TransposeProduct:
+    """``Aᵀ B`` that keeps PETSc's symbolic product while the patterns of
+    ``A`` and ``B`` stay the same, as they do between Newton iterations once
+    the contact pairs stop changing.
+
+    The symbolic phase of MatMatMult walks every row of ``Aᵀ``, that is every
+    dof of the mesh, and was 85% of a fresh product: 27.5 ms against 4.1 ms
+    numeric only for the contact stiffness of Hertz 3D at 81k dofs. PETSc
+    cannot tell a changed pattern on reuse and would then compute wrong
+    entries silently, so the patterns are compared exactly, on every rank,
+    and the decision is collective.
+
+    The returned matrix belongs to this object and is overwritten by the
+    next call: copy it before changing it or keeping it.
+    """
+
+    def __init__(self) -> None:
+        self._patterns: Optional[tuple] = None
+        self._product: Optional[PETSc.Mat] = None
+
+    def __call__(self, A: PETSc.Mat, B: PETSc.Mat) -> PETSc.Mat:
+        patterns = (_pattern(A), _pattern(B))
+        same = (self._patterns is not None
+                and all(np.array_equal(new, old)
+                        for pair_new, pair_old in zip(patterns, self._patterns)
+                        for new, old in zip(pair_new, pair_old)))
+        if not A.getComm().tompi4py().allreduce(bool(same), op=MPI.LAND):
+            self._product = transpose_mat_mult(A, B)
+            self._patterns = patterns
+            return self._product
+        At = PETSc.Mat()
+        A.transpose(At)
+        At.matMult(B, result=self._product)
+        At.destroy()
+        return self._product
+
+
 class PatternTrackingAdd:
     """``A += K`` for a contact stiffness ``K`` whose pattern may change between
     Newton iterations (pairs come and go as the surfaces move).

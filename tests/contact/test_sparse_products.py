@@ -1,11 +1,13 @@
-"""Adding a contact stiffness whose pattern moves (PatternTrackingAdd), on 1 and 2 ranks."""
+"""Sparse products and adds of the contact stiffness (PatternTrackingAdd,
+TransposeProduct), on 1 and 2 ranks."""
 from __future__ import annotations
 
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.sparse_products import PatternTrackingAdd
+from dolfinx_mortar.contact.sparse_products import (PatternTrackingAdd, TransposeProduct,
+                                                     transpose_mat_mult)
 
 N = 40
 
@@ -80,3 +82,48 @@ def test_plain_subset_add_would_malloc():
     A.axpy(1.0, _far_coupling(17, 0.5), structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
     A.assemble()
     assert _mallocs(A) > 0
+
+
+def _rectangular(rows: int, shift: int, seed: int) -> PETSc.Mat:
+    """A rows × N matrix with three entries per row at columns that depend on
+    ``shift``, values from ``seed``; rows on both ranks' parts."""
+    rng = np.random.default_rng(seed)
+    G = PETSc.Mat().createAIJ((rows, N), nnz=(3, 3), comm=MPI.COMM_WORLD)
+    start, end = G.getOwnershipRange()
+    values = rng.normal(size=(rows, 3))
+    for i in range(start, end):
+        columns = [(i * 7 + shift * k) % N for k in (1, 2, 3)]
+        G.setValues([i], sorted(set(columns)), values[i, :len(set(columns))])
+    G.assemble()
+    return G
+
+
+def _dense_rectangular(G: PETSc.Mat) -> np.ndarray:
+    start, end = G.getOwnershipRange()
+    local = np.zeros((end - start, G.getSize()[1]))
+    for i in range(start, end):
+        cols, vals = G.getRow(i)
+        local[i - start, cols] = vals
+    return np.vstack(MPI.COMM_WORLD.allgather(local))
+
+
+def test_transpose_product_reuses_only_an_unchanged_pattern():
+    """Gᵀ·(s G) with new values on the same pattern reuses the matrix (numeric
+    phase only) and equals the fresh product; a new pattern makes a new one."""
+    product = TransposeProduct()
+    previous = None
+    for shift, seed, reused in ((3, 1, False), (3, 2, True), (5, 3, False), (5, 4, True),
+                                (3, 5, False)):
+        G = _rectangular(15, shift, seed)
+        SG = G.copy()
+        scale = G.createVecLeft()
+        scale.setArray(np.linspace(0.5, 2.0, scale.getSize())[slice(*scale.getOwnershipRange())])
+        SG.diagonalScale(scale, None)
+        K = product(G, SG)
+        assert (K is previous) == reused
+        previous = K
+        dense = _dense_rectangular(G)
+        expected = dense.T @ (np.linspace(0.5, 2.0, len(dense))[:, None] * dense)
+        assert np.max(np.abs(_dense(K) - expected)) <= 1e-14 * np.max(np.abs(expected))
+        assert np.allclose(_dense(K), _dense(transpose_mat_mult(G, SG)), rtol=0,
+                           atol=1e-14 * np.max(np.abs(expected)))
