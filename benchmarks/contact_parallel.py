@@ -13,10 +13,13 @@ not fall with the rank count.
     OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/contact_parallel.py --refine 2
     mpirun -n 2 /usr/bin/python3 benchmarks/contact_parallel.py --refine 2 [--profile]
 
-Writes ``contact_parallel_n{ranks}.csv`` into ``--out`` (default
+``--partitioner graph`` uses DOLFINx's graph partition alone, as before the
+contact-balanced partitioner (the default).
+
+Writes ``contact_parallel_{partitioner}_n{ranks}.csv`` into ``--out`` (default
 ``benchmarks/results/``); ``--profile`` also writes each rank's cProfile of
 the solve (cumulative, the 40 most expensive) as
-``contact_parallel_n{ranks}_rank{r}.txt``.
+``contact_parallel_{partitioner}_n{ranks}_rank{r}.txt``.
 """
 from __future__ import annotations
 
@@ -56,6 +59,9 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--penalty", type=float, default=1e3, help="ε as a multiple of E/h")
     parser.add_argument("--linear-solver", default="iterative",
                         choices=("iterative", "direct"))
+    parser.add_argument("--partitioner", default="contact", choices=("contact", "graph"),
+                        help="hertz3d --partitioner: contact cells dealt out evenly "
+                             "(contact) or DOLFINx's graph partition alone (graph)")
     parser.add_argument("--profile", action="store_true",
                         help="also write each rank's cProfile of the solve")
     parser.add_argument("--out", default=str(HERE / "results"))
@@ -91,9 +97,10 @@ def rank_row(problem, result, wall: float) -> dict:
     return row
 
 
-def table(rows: list[dict], load: float) -> str:
+def table(rows: list[dict], load: float, partitioner: str) -> str:
     r0 = rows[0]
-    lines = [f"Hertz 3D two bodies, {r0['dofs']} dofs, {len(rows)} rank(s), "
+    lines = [f"Hertz 3D two bodies, {r0['dofs']} dofs, {len(rows)} rank(s), {partitioner} "
+             f"partition, "
              f"{r0['newton']} Newton and {r0['krylov']} Krylov iterations; 1-minute load "
              f"average before the run {load:.2f} on {os.cpu_count()} cores; times in s", "",
              "| " + " | ".join(title for title, _, _ in TABLE) + " |",
@@ -108,7 +115,8 @@ def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
     demo = load_demo("hertz3d")
     demo_args = demo.parse_args(["--obstacle", "elastic", "--refine", str(args.refine),
                                  "--penalty", str(args.penalty),
-                                 "--linear-solver", args.linear_solver])
+                                 "--linear-solver", args.linear_solver,
+                                 "--partitioner", args.partitioner])
     profiler = cProfile.Profile() if args.profile else None
     comm.Barrier()
     clock = time.perf_counter()
@@ -121,7 +129,7 @@ def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
     wall = time.perf_counter() - clock
     rows = comm.gather(rank_row(problem, result, wall))
     out = Path(args.out)
-    stem = f"contact_parallel_n{comm.size}"
+    stem = f"contact_parallel_{args.partitioner}_n{comm.size}"
     if profiler:
         text = io.StringIO()
         pstats.Stats(profiler, stream=text).sort_stats("cumulative").print_stats(40)
@@ -130,7 +138,7 @@ def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
     if comm.rank == 0:
         out.mkdir(parents=True, exist_ok=True)
         write_csv(out / f"{stem}.csv", rows, COLUMNS)
-        print(table(rows, load))
+        print(table(rows, load, args.partitioner))
     return rows or []
 
 

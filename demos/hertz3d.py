@@ -54,6 +54,10 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"),
                         help="built-in scene: rigid plane, or an elastic block [0,R]²×[−R,0]")
+    parser.add_argument("--partitioner", default="contact", choices=("contact", "graph"),
+                        help="built-in mesh on several ranks: give every rank an equal share "
+                             "of the contact surfaces' cells (contact, the default) or use "
+                             "DOLFINx's graph partition alone (graph)")
     parser.add_argument("--mesh", default=None, help="gmsh .msh file with the named groups")
     parser.add_argument("--write-mesh", default=None,
                         help="also write the built-in mesh to this .msh file (for other codes)")
@@ -76,8 +80,7 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
     file; optionally also written to ``path`` (.msh) so that other codes can
     solve the very same mesh."""
     import gmsh
-    from dolfinx.io import gmshio
-    from dolfinx_mortar.io.gmsh_io import grade_towards_point
+    from dolfinx_mortar.io.gmsh_io import grade_towards_point, model_to_mesh
     R = args.radius
     h_contact = a / (8 * args.refine)
     gmsh.initialize(["", "-v", "0"])
@@ -119,7 +122,10 @@ def build_octant(args, a: float, comm: MPI.Comm, path: Optional[str] = None):
             gmsh.model.mesh.generate(3)
             if path is not None:
                 gmsh.write(path)
-        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=3)
+        contact = [SLAVE] + ([MASTER] if args.obstacle == "elastic" else [])
+        domain, _, facet_tags = model_to_mesh(
+            gmsh.model, comm, 0, gdim=3,
+            balance_facets=contact if args.partitioner == "contact" else None)
     finally:
         gmsh.finalize()
     names = {name: i + 1 for i, name in enumerate(NAMES)
