@@ -59,7 +59,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--penalty", type=float, default=1e3, help="ε as a multiple of E/h")
     parser.add_argument("--linear-solver", default="iterative",
                         choices=("iterative", "direct"))
-    parser.add_argument("--partitioner", default="contact", choices=("contact", "graph"),
+    parser.add_argument("--partitioner", default="graph", choices=("graph", "contact"),
                         help="hertz3d --partitioner: contact cells dealt out evenly "
                              "(contact) or DOLFINx's graph partition alone (graph)")
     parser.add_argument("--profile", action="store_true",

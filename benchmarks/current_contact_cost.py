@@ -27,6 +27,8 @@ def main() -> None:
     parser.add_argument("--refine", type=float, default=1.5)
     parser.add_argument("--load-steps", type=int, default=1)
     parser.add_argument("--configurations", nargs="+", default=["current", "initial"])
+    parser.add_argument("--partitioner", default="graph", choices=("graph", "contact"),
+                        help="hertz3d --partitioner, for runs on several ranks (graph)")
     parser.add_argument("--out", default="benchmarks/results/current_contact_cost")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
@@ -36,7 +38,8 @@ def main() -> None:
     for configuration in args.configurations:
         dargs = demo.parse_args(["--obstacle", "elastic", "--refine", str(args.refine),
                                  "--basis-configuration", configuration,
-                                 "--load-steps", str(args.load_steps)])
+                                 "--load-steps", str(args.load_steps),
+                                 "--partitioner", args.partitioner])
         clock = time.perf_counter()
         problem, context = demo.build_problem(dargs, comm)
         result = problem.solve(load_steps=dargs.load_steps)
@@ -60,7 +63,7 @@ def main() -> None:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         write_csv(args.out + ".csv", rows, COLUMNS)
         lines = [f"Hertz 3D, two bodies, refine {args.refine}, {args.load_steps} load step(s), "
-                 f"{comm.size} rank(s); load average {load:.2f} at the start", "",
+                 f"{comm.size} rank(s), {args.partitioner} partition; load average {load:.2f} at the start", "",
                  "| configuration | dofs | Newton | wall s | contact s / Newton | "
                  "bulk assembly s / Newton | contact / bulk | p0 err | a err |",
                  "|---|---|---|---|---|---|---|---|---|"]

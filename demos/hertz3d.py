@@ -54,10 +54,11 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--obstacle", default="rigid", choices=("rigid", "elastic"),
                         help="built-in scene: rigid plane, or an elastic block [0,R]²×[−R,0]")
-    parser.add_argument("--partitioner", default="contact", choices=("contact", "graph"),
-                        help="built-in mesh on several ranks: give every rank an equal share "
-                             "of the contact surfaces' cells (contact, the default) or use "
-                             "DOLFINx's graph partition alone (graph)")
+    parser.add_argument("--partitioner", default="graph", choices=("graph", "contact"),
+                        help="built-in mesh on several ranks: DOLFINx's graph partition "
+                             "(graph, the default) or every rank an equal share of the cells "
+                             "near contact (contact; pays off when the contact work is large "
+                             "next to the bulk's, docs/SCALING.md)")
     parser.add_argument("--mesh", default=None, help="gmsh .msh file with the named groups")
     parser.add_argument("--write-mesh", default=None,
                         help="also write the built-in mesh to this .msh file (for other codes)")

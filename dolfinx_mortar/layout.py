@@ -193,22 +193,32 @@ def assemble_blocks(rows: NodeLayout, row_cells: IntArray, cols: NodeLayout,
 
 
 def assemble_global_blocks(layout: NodeLayout, row_global: IntArray, col_global: IntArray,
-                           blocks: FloatArray) -> PETSc.Mat:
-    """Assemble dense blocks into a square AIJ matrix over ``layout``, with rows
-    given by global index: they may be owned by any rank (PETSc sends them).
+                           blocks: FloatArray, cols: Optional[NodeLayout] = None) -> PETSc.Mat:
+    """Assemble dense blocks into an AIJ matrix over ``layout`` (× ``cols``,
+    default ``layout``), with rows given by global index: they may be owned by
+    any rank (PETSc sends them).
 
     Needed where a block's rows are not this rank's functions or ghosts, e.g.
     the second derivatives of a slave–master pair, whose master rows can live
     anywhere. ``blocks``: (blocks, nr, nc), added where they overlap.
+    Collective. Every owned row is preallocated for the blocks of all ranks
+    (one reduction over the global rows).
     """
     row_global = np.asarray(row_global, dtype=np.int64)
     nc = np.asarray(col_global).shape[1] if row_global.shape[0] else 1
-    # rows this rank fills get room for every block that touches them;
-    # other ranks' contributions beyond that allocate as they arrive
-    owned = row_global - layout.offset
-    owned = owned[(owned >= 0) & (owned < layout.num_owned)]
-    mat = _block_matrix(layout, layout, np.bincount(owned, minlength=layout.num_owned) * nc + 1,
-                        row_global, col_global, blocks)
+    # every owned row gets room for the blocks of all ranks that touch it: the
+    # blocks a rank computes need not be its own rows (the Hessians of the
+    # current configuration are shared out evenly), and entries that arrive
+    # beyond the preallocation are one malloc each
+    comm = layout.comm
+    touches = np.bincount(row_global.ravel(), minlength=layout.size_global).astype(np.int64)
+    if comm.size > 1:
+        owned_counts = np.array(comm.allgather(layout.num_owned), dtype=np.int64)
+        mine = np.empty(layout.num_owned, dtype=np.int64)
+        comm.Reduce_scatter(touches, mine, recvcounts=owned_counts, op=MPI.SUM)
+        touches = mine
+    mat = _block_matrix(layout, cols or layout, touches * nc + 1, row_global, col_global,
+                        blocks)
     mat.assemble()
     return mat
 

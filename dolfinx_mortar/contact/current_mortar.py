@@ -20,6 +20,7 @@ from typing import Optional
 
 import numpy as np
 import numpy.typing as npt
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
@@ -40,6 +41,20 @@ SUPPORTED_3D = ("P1 triangle", "Q1 quadrilateral")
 #: search_radius is given: surfaces further apart than that carry no force or
 #: stiffness, and a penetration that deep is far outside a penalty solution
 FACET_SEARCH_FACTOR = 2.0
+
+
+def share_evenly(comm: MPI.Comm, pairs: npt.NDArray[np.int64], weights: FloatArray
+                 ) -> tuple[npt.NDArray[np.int64], FloatArray]:
+    """This rank's equal share (by count, in rank order) of all ranks' pairs
+    and their per-pair weights. Collective."""
+    counts = comm.allgather(len(pairs))
+    total = sum(counts)
+    if comm.size == 1:
+        return pairs, weights
+    start, end = total * comm.rank // comm.size, total * (comm.rank + 1) // comm.size
+    every_pair = np.concatenate(comm.allgather(np.asarray(pairs, dtype=np.int64).reshape(-1, 2)))
+    every_weight = np.concatenate(comm.allgather(np.asarray(weights, dtype=np.float64)))
+    return every_pair[start:end], every_weight[start:end]
 
 
 class CurrentMortarGap(CurrentSurfaceGap):
@@ -81,6 +96,11 @@ class CurrentMortarGap(CurrentSurfaceGap):
         comm = slave.layout.comm
         #: index of this rank's first slave cell in the gathered slave surface
         self._first_cell = comm.scan(len(slave.cells)) - len(slave.cells)
+        #: global function ids of the gathered slave surface's cells (rows of
+        #: pairs computed on another rank than the one that holds them)
+        self._gathered_slave_ids = np.concatenate(
+            comm.allgather(slave.layout.global_indices[slave.cells])).reshape(
+                -1, slave.cells.shape[1])
         self.covered = np.zeros(slave.layout.size_local, dtype=bool)
         #: the kernel's coupling at the last evaluation (pairs, reference values)
         self.coupling: Optional[MortarCoupling] = None
@@ -98,16 +118,26 @@ class CurrentMortarGap(CurrentSurfaceGap):
         slave nodes, master cell; −1 pads); with ``with_positive_part`` also
         ``value_plus`` and ``gradient_plus``, the same for ``c⁺_A = ∫ N_A ⟨d⟩``.
         """
+        pairs = coupling.pairs if which is None else coupling.pairs[which]
+        return self.gathered_pair_derivatives(u_nodes, coupling,
+                                              pairs + np.array([self._first_cell, 0]),
+                                              with_hessian, with_positive_part)
+
+    def gathered_pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
+                                  gathered_pairs: npt.NDArray[np.int64], with_hessian: bool,
+                                  with_positive_part: bool = False) -> dict:
+        """:meth:`pair_derivatives` of pairs given in the gathered numbering
+        (slave cell of the gathered slave surface, master cell): any rank can
+        compute any rank's pairs, as every rank holds both gathered surfaces.
+        Collective (the slave surface is gathered at u)."""
         slave = self.slave
         copy = gather_surface(slave, slave.x + u_nodes)
         master = coupling.master_copy
-        pairs = coupling.pairs if which is None else coupling.pairs[which]
-        pairs = pairs + np.array([self._first_cell, 0])
         return _kernels.current_pair_gaps(
             slave.facet_type, copy.x, copy.cells, copy.global_ids.astype(np.int64),
             master.facet_type, master.x, master.cells, master.global_ids.astype(np.int64),
-            pairs.astype(np.int32), self.segment_points, self.segment_weights,
-            coupling.zero_length, with_hessian=with_hessian,
+            np.asarray(gathered_pairs, dtype=np.int32).reshape(-1, 2), self.segment_points,
+            self.segment_weights, coupling.zero_length, with_hessian=with_hessian,
             with_positive_part=with_positive_part, axisymmetric=slave.axisymmetric)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
@@ -138,28 +168,41 @@ class CurrentMortarGap(CurrentSurfaceGap):
             near |= layout.on_cells(all_cells[penetrating])
         kept = np.any(near[all_cells], axis=1)
         cells = all_cells[kept]
+        self.covered = layout.on_cells(all_cells)
+        ns = cells.shape[1]
+        data = {"cells": cells, "pairs": np.flatnonzero(kept), "u_nodes": u_nodes,
+                "coupling": coupling, "kept": kept}
         # the residual needs gradients only; _gap_hessian asks for the Hessians
         # when (and if) a Jacobian is assembled at this u
-        r = self.pair_derivatives(u_nodes, coupling, kept, with_hessian=False,
-                                  with_positive_part=self.pointwise)
-        dofs = self._variable_dofs(r["nodes"], len(cells))
-        nv = dofs.shape[1]
-        ns = cells.shape[1]
-        value = r["value"]
-        grad = r["gradient"].reshape(len(cells), ns, nv)
-        # φ_a = Σ_b N_b C_ba
-        value = value @ self.C
-        grad = np.einsum("pbn,ba->pan", grad, self.C)
-        self.covered = layout.on_cells(all_cells)
-        G_g = assemble_blocks(layout, cells, self.dofs, dofs, grad)
-        data = {"cells": cells, "dofs": dofs, "value": value, "pairs": np.flatnonzero(kept),
-                "u_nodes": u_nodes, "coupling": coupling, "kept": kept}
         if self.pointwise:
+            # ĝ⁺ is summed at the nodes from the kept pairs' values, on the
+            # rank that holds the pairs (not shared out: see _gap_hessian)
+            r = self.pair_derivatives(u_nodes, coupling, kept, with_hessian=False,
+                                      with_positive_part=True)
+            dofs = self._variable_dofs(r["nodes"], len(cells))
+            nv = dofs.shape[1]
+            grad = np.einsum("pbn,ba->pan", r["gradient"].reshape(len(cells), ns, nv), self.C)
+            G_g = assemble_blocks(layout, cells, self.dofs, dofs, grad)
             # ĝ⁺ from the kept pairs: every pair with a penetrating point is kept
             data["g_plus"] = layout.sum_at_functions(cells, r["value_plus"] @ self.C)
             grad_plus = np.einsum("pbn,ba->pan",
                                   r["gradient_plus"].reshape(len(cells), ns, nv), self.C)
             data["G_g_plus"] = assemble_blocks(layout, cells, self.dofs, dofs, grad_plus)
+        else:
+            # the gradients are shared out over the ranks like the Hessians
+            # (_gap_hessian): 25 times the cost of the values, where the
+            # surfaces press, often on one rank
+            pairs, _ = share_evenly(layout.comm, coupling.pairs[kept]
+                                    + np.array([self._first_cell, 0]),
+                                    np.zeros((int(np.sum(kept)), 0)))
+            r = self.gathered_pair_derivatives(u_nodes, coupling, pairs, with_hessian=False)
+            dofs = self._variable_dofs(r["nodes"], len(pairs))
+            nv = dofs.shape[1]
+            # φ_a = Σ_b N_b C_ba
+            grad = np.einsum("pbn,ba->pan", r["gradient"].reshape(len(pairs), ns, nv), self.C)
+            G_g = assemble_global_blocks(layout, self._gathered_slave_ids[pairs[:, 0]], dofs,
+                                         grad, cols=self.dofs)
+        data["dofs"] = dofs
         return g, G_g, data
 
     def near_contact(self, g: FloatArray, W: FloatArray) -> npt.NDArray[np.bool_]:
@@ -205,13 +248,18 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # (100-200 times the cost of its values) is skipped. On Hertz 3D these
         # are most of the pairs kept for the gradients.
         needed = np.any(Fg[cells] != 0.0, axis=1)
-        which = np.zeros(len(data["kept"]), dtype=bool)
-        which[data["pairs"][needed]] = True
-        r = self.pair_derivatives(data["u_nodes"], data["coupling"], which,
-                                  with_hessian=True)
-        n = int(np.sum(needed))
+        pairs = (data["coupling"].pairs[data["pairs"][needed]]
+                 + np.array([self._first_cell, 0]))
+        # The Hessians are most of the contact work, and they sit where the
+        # surfaces press, often on one rank. Every rank holds both gathered
+        # surfaces and the blocks are added by global dof, so each rank takes
+        # an equal share of all ranks' pairs instead of its own.
+        pairs, weights = share_evenly(self.slave.layout.comm, pairs, weights[needed])
+        r = self.gathered_pair_derivatives(data["u_nodes"], data["coupling"], pairs,
+                                           with_hessian=True)
+        n = len(pairs)
         dofs = self._variable_dofs(r["nodes"], n)
         nv = dofs.shape[1]
         hess = r["hessian"].reshape(n, cells.shape[1], nv, nv)
-        blocks = np.einsum("pb,pbmn->pmn", weights[needed], hess)
+        blocks = np.einsum("pb,pbmn->pmn", weights, hess)
         return assemble_global_blocks(self.dofs, dofs, dofs, blocks)
