@@ -10,12 +10,12 @@ from dolfinx import fem
 import ufl
 
 from dolfinx_mortar.io.contact_partitioner import cells_near_contact, coordinate_bisection
-from dolfinx_mortar.io.gmsh_io import grade_towards_point, model_to_mesh
+from dolfinx_mortar.io.gmsh_io import grade_towards_point, model_to_mesh, read_gmsh
 
 LOWER, UPPER, MASTER, SLAVE, FAR = 1, 2, 3, 4, 5
 
 
-def stacked_blocks(comm: MPI.Comm, balance, size: float = 0.12):
+def stacked_blocks(comm: MPI.Comm, balance, size: float = 0.12, path=None):
     """Two unit-square blocks, [0,1]²×[−1,0] and [0,1]²×[0,1], meshed
     separately, graded towards the corner (0, 0, 0) of their touching faces
     (MASTER: the lower block's top, SLAVE: the upper block's bottom, FAR:
@@ -28,14 +28,18 @@ def stacked_blocks(comm: MPI.Comm, balance, size: float = 0.12):
             lower = occ.addBox(0, 0, -1, 1, 1, 1)
             upper = occ.addBox(0, 0, 0, 1, 1, 1)
             occ.synchronize()
-            for tag, volume, z in ((MASTER, lower, 0.0), (SLAVE, upper, 0.0), (FAR, upper, 1.0)):
+            for tag, volume, z, name in ((MASTER, lower, 0.0, "master"),
+                                         (SLAVE, upper, 0.0, "slave"), (FAR, upper, 1.0, "far")):
                 faces = [s for _, s in gmsh.model.getBoundary([(3, volume)], oriented=False)
                          if abs(occ.getCenterOfMass(2, s)[2] - z) < 1e-9]
                 gmsh.model.addPhysicalGroup(2, faces, tag)
+                gmsh.model.setPhysicalName(2, tag, name)
             gmsh.model.addPhysicalGroup(3, [lower], LOWER)
             gmsh.model.addPhysicalGroup(3, [upper], UPPER)
             grade_towards_point((0, 0, 0), size / 4, size * 2, 0.2, 1.0)
             gmsh.model.mesh.generate(3)
+            if path is not None:
+                gmsh.write(str(path))
         return model_to_mesh(gmsh.model, comm, 0, gdim=3, balance_facets=balance)
     finally:
         gmsh.finalize()
@@ -117,3 +121,18 @@ def test_balance_tags_must_be_facet_groups():
         stacked_blocks(MPI.COMM_WORLD, [SLAVE, 9], size=0.5)
     with pytest.raises(ValueError, match=r"balance_facets \[1\]"):  # a volume group
         stacked_blocks(MPI.COMM_WORLD, [LOWER], size=0.5)
+
+
+def test_a_gmsh_file_is_balanced_by_group_names(tmp_path_factory):
+    comm = MPI.COMM_WORLD
+    path = comm.bcast(str(tmp_path_factory.mktemp("msh") / "blocks.msh")
+                      if comm.rank == 0 else None)
+    if comm.rank == 0:
+        stacked_blocks(MPI.COMM_SELF, None, path=path)
+    comm.barrier()
+    mesh, _, facet_tags, names = read_gmsh(path, comm, balance_facets=["slave", "master"])
+    assert names[2]["slave"] == SLAVE
+    counts = comm.allgather(owned_facets(mesh, facet_tags, SLAVE))
+    assert min(counts) >= 0.8 * sum(counts) / comm.size, counts
+    with pytest.raises(ValueError, match=r"balance_facets \['top'\]"):
+        read_gmsh(path, comm, balance_facets=["slave", "top"])
