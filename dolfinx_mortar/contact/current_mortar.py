@@ -43,18 +43,14 @@ SUPPORTED_3D = ("P1 triangle", "Q1 quadrilateral")
 FACET_SEARCH_FACTOR = 2.0
 
 
-def share_evenly(comm: MPI.Comm, pairs: npt.NDArray[np.int64], weights: FloatArray
-                 ) -> tuple[npt.NDArray[np.int64], FloatArray]:
-    """This rank's equal share (by count, in rank order) of all ranks' pairs
-    and their per-pair weights. Collective."""
-    counts = comm.allgather(len(pairs))
-    total = sum(counts)
+def share_evenly(comm: MPI.Comm, *per_pair: npt.NDArray) -> tuple[npt.NDArray, ...]:
+    """This rank's equal share (by count, in rank order) of all ranks' rows of
+    the given per-pair arrays (pairs, weights, ...). Collective."""
     if comm.size == 1:
-        return pairs, weights
+        return per_pair
+    total = comm.allreduce(len(per_pair[0]))
     start, end = total * comm.rank // comm.size, total * (comm.rank + 1) // comm.size
-    every_pair = np.concatenate(comm.allgather(np.asarray(pairs, dtype=np.int64).reshape(-1, 2)))
-    every_weight = np.concatenate(comm.allgather(np.asarray(weights, dtype=np.float64)))
-    return every_pair[start:end], every_weight[start:end]
+    return tuple(np.concatenate(comm.allgather(np.asarray(a)))[start:end] for a in per_pair)
 
 
 class CurrentMortarGap(CurrentSurfaceGap):
@@ -192,9 +188,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
             # the gradients are shared out over the ranks like the Hessians
             # (_gap_hessian): 25 times the cost of the values, where the
             # surfaces press, often on one rank
-            pairs, _ = share_evenly(layout.comm, coupling.pairs[kept]
-                                    + np.array([self._first_cell, 0]),
-                                    np.zeros((int(np.sum(kept)), 0)))
+            pairs, = share_evenly(layout.comm,
+                                  coupling.pairs[kept] + np.array([self._first_cell, 0]))
             r = self.gathered_pair_derivatives(u_nodes, coupling, pairs, with_hessian=False)
             dofs = self._variable_dofs(r["nodes"], len(pairs))
             nv = dofs.shape[1]
