@@ -103,7 +103,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
 
     def pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
                          which: Optional[npt.NDArray[np.bool_]] = None,
-                         with_hessian: bool = True, with_positive_part: bool = False) -> dict:
+                         with_hessian: bool = True, with_positive_part: bool = False,
+                         node_weights: Optional[FloatArray] = None) -> dict:
         """``c_A = ∫ N_A d`` of the pairs of ``coupling`` (all, or those where
         ``which`` is True) with exact derivatives (the Hessians only with
         ``with_hessian``).
@@ -113,15 +114,18 @@ class CurrentMortarGap(CurrentSurfaceGap):
         nv / gdim), the global node ids of the variables (slave cell, other
         slave nodes, master cell; −1 pads); with ``with_positive_part`` also
         ``value_plus`` and ``gradient_plus``, the same for ``c⁺_A = ∫ N_A ⟨d⟩``.
+        With ``node_weights`` (pairs, ns): those of the one function
+        ``Σ_A w_A c_A`` per pair instead (ns = 1), what a Newton matrix needs.
         """
         pairs = coupling.pairs if which is None else coupling.pairs[which]
         return self.gathered_pair_derivatives(u_nodes, coupling,
                                               pairs + np.array([self._first_cell, 0]),
-                                              with_hessian, with_positive_part)
+                                              with_hessian, with_positive_part, node_weights)
 
     def gathered_pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
                                   gathered_pairs: npt.NDArray[np.int64], with_hessian: bool,
-                                  with_positive_part: bool = False) -> dict:
+                                  with_positive_part: bool = False,
+                                  node_weights: Optional[FloatArray] = None) -> dict:
         """:meth:`pair_derivatives` of pairs given in the gathered numbering
         (slave cell of the gathered slave surface, master cell): any rank can
         compute any rank's pairs, as every rank holds both gathered surfaces.
@@ -134,7 +138,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
             master.facet_type, master.x, master.cells, master.global_ids.astype(np.int64),
             np.asarray(gathered_pairs, dtype=np.int32).reshape(-1, 2), self.segment_points,
             self.segment_weights, coupling.zero_length, with_hessian=with_hessian,
-            with_positive_part=with_positive_part, axisymmetric=slave.axisymmetric)
+            with_positive_part=with_positive_part, axisymmetric=slave.axisymmetric,
+            node_weights=node_weights)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
@@ -250,11 +255,10 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # surfaces and the blocks are added by global dof, so each rank takes
         # an equal share of all ranks' pairs instead of its own.
         pairs, weights = share_evenly(self.slave.layout.comm, pairs, weights[needed])
+        # the kernel sums the weighted Hessians (one per pair, not ns)
         r = self.gathered_pair_derivatives(data["u_nodes"], data["coupling"], pairs,
-                                           with_hessian=True)
+                                           with_hessian=True, node_weights=weights)
         n = len(pairs)
         dofs = self._variable_dofs(r["nodes"], n)
         nv = dofs.shape[1]
-        hess = r["hessian"].reshape(n, cells.shape[1], nv, nv)
-        blocks = np.einsum("pb,pbmn->pmn", weights, hess)
-        return assemble_global_blocks(self.dofs, dofs, dofs, blocks)
+        return assemble_global_blocks(self.dofs, dofs, dofs, r["hessian"].reshape(n, nv, nv))

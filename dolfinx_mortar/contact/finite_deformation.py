@@ -44,11 +44,13 @@ FloatArray = npt.NDArray[np.float64]
 
 
 
-def area_element_derivatives(F: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+def area_element_derivatives(F: FloatArray, second: bool = True
+                             ) -> tuple[FloatArray, FloatArray, Optional[FloatArray]]:
     """``J = sqrt(det FᵀF)`` and its first and second derivatives with respect to F.
 
     ``F``: (..., gdim, tdim). Returns J (...), dJ (..., gdim, tdim) and
-    d2J (..., gdim, tdim, gdim, tdim). With ``P = F G⁻¹``:
+    d2J (..., gdim, tdim, gdim, tdim), or None for d2J unless ``second``.
+    With ``P = F G⁻¹``:
     ``∂J/∂F_ia = J P_ia`` and
     ``∂²J/∂F_ia∂F_jb = J (P_ia P_jb + δ_ij G⁻¹_ab − P_ib P_ja − (P Fᵀ)_ij G⁻¹_ab)``.
     """
@@ -57,6 +59,8 @@ def area_element_derivatives(F: FloatArray) -> tuple[FloatArray, FloatArray, Flo
     J = np.sqrt(np.linalg.det(G))
     P = F @ Ginv
     dJ = J[..., None, None] * P
+    if not second:
+        return J, dJ, None
     gdim = F.shape[-2]
     delta = np.eye(gdim)
     PF = np.einsum("...ia,...ja->...ij", P, F)
@@ -172,32 +176,49 @@ class CurrentSurfaceGap(GapModelBase):
     # -- element quantities ------------------------------------------------------------
     def _elements(self, u_nodes: FloatArray) -> dict:
         """Area element J of every slave cell at the quadrature points, with its
-        first and second derivatives with respect to the cell's node positions."""
+        first derivatives with respect to the cell's node positions; the second
+        ones on demand (:meth:`_element_hessians`: a residual needs none, and
+        they were 17% of the current configuration's contact work)."""
         x = (self.slave.x + u_nodes)[self.slave.cells]              # (c, nd, gdim)
         F = np.einsum("cbi,qab->cqia", x, self.dN)                  # (c, q, gdim, tdim)
-        J, dJdF, d2JdF = area_element_derivatives(F)
+        J, dJdF, _ = area_element_derivatives(F, second=False)
         # chain rule through F = Σ_b x_b ⊗ ∇N_b
         dJ = np.einsum("cqia,qab->cqbi", dJdF, self.dN)             # (c, q, nd, gdim)
-        d2J = np.einsum("nqiajc,qab,qce->nqbiej", d2JdF, self.dN, self.dN)
         xq = np.einsum("qb,cbi->cqi", self.N, x)
+        e = {"F": F, "x": xq, "J": J, "dJ": dJ}
         if self.slave.axisymmetric:
-            J, dJ, d2J = self._swept(J, dJ, d2J, xq)
-        return {"J": J, "dJ": dJ, "d2J": d2J, "x": xq}
+            R, dR = self._revolution(xq)
+            e["meridian_dJ"] = dJ                          # of J before the factor 2πr
+            e["J"] = J * R
+            e["dJ"] = dJ * R[..., None, None] + J[..., None, None] * dR[None]
+        return e
 
-    def _swept(self, J: FloatArray, dJ: FloatArray, d2J: FloatArray, xq: FloatArray
-               ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """The measure of an (r, z) meridian's surface of revolution, ``J·2πr``
-        with ``r = Σ_b N_b x_b,r`` at each point, and its derivatives (r
-        clamped at 0 as in :meth:`LagrangeSurface.radial_factor`: an axis node
-        may sit at −1e-17)."""
+    def _element_hessians(self, e: dict) -> FloatArray:
+        """∂²J of :meth:`_elements`' ``e`` (c, q, nd, gdim, nd, gdim), computed
+        once and kept in ``e``."""
+        if "d2J" not in e:
+            _, _, d2JdF = area_element_derivatives(e["F"])
+            d2J = np.einsum("nqiajc,qab,qce->nqbiej", d2JdF, self.dN, self.dN,
+                            optimize=True)
+            if self.slave.axisymmetric:
+                # (J R)'' = J'' R + J' ⊗ R' + R' ⊗ J' (R is linear in the nodes)
+                R, dR = self._revolution(e["x"])
+                dJ = e["meridian_dJ"]
+                d2J = (d2J * R[..., None, None, None, None]
+                       + np.einsum("cqbi,qej->cqbiej", dJ, dR)
+                       + np.einsum("qbi,cqej->cqbiej", dR, dJ))
+            e["d2J"] = d2J
+        return e["d2J"]
+
+    def _revolution(self, xq: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The factor 2πr of an (r, z) meridian's surface of revolution at each
+        point, ``r = Σ_b N_b x_b,r`` (clamped at 0 as in
+        :meth:`LagrangeSurface.radial_factor`: an axis node may sit at −1e-17),
+        and its derivative with respect to the cell's nodes (q, nd, gdim)."""
         R = 2 * np.pi * np.maximum(xq[..., 0], 0.0)                 # (c, q)
-        dR = np.zeros(dJ.shape[1:])                                 # (q, nd, gdim)
+        dR = np.zeros(self.N.shape + (self.slave.gdim,))            # (q, nd, gdim)
         dR[..., 0] = 2 * np.pi * self.N
-        d2J_swept = (d2J * R[..., None, None, None, None]
-                     + np.einsum("cqbi,qej->cqbiej", dJ, dR)
-                     + np.einsum("qbi,cqej->cqbiej", dR, dJ))
-        dJ_swept = dJ * R[..., None, None] + J[..., None, None] * dR[None]
-        return J * R, dJ_swept, d2J_swept
+        return R, dR
 
     def _nodal_coefficients(self, g: FloatArray, W: FloatArray, active: FloatArray):
         """∂F/∂ĝ, ∂F/∂W and the second derivatives of F = (ε/2) W^m ⟨ĝ W^{−k}⟩²."""
@@ -343,7 +364,8 @@ class CurrentSurfaceGap(GapModelBase):
         nc, nd = cells.shape
         width = nd * self.slave.gdim
         b = np.einsum("ca,qa->cq", state.FW[cells], self.N)
-        blocks = np.einsum("cq,cqbiej->cbiej", self.wq[None, :] * b, state.element["d2J"])
+        blocks = np.einsum("cq,cqbiej->cbiej", self.wq[None, :] * b,
+                           self._element_hessians(state.element))
         K_el = assemble_blocks(self.dofs, self.cell_dofs_local, self.dofs, self.cell_dofs,
                                blocks.reshape(nc, width, width))
         K_el.axpy(1.0, self._gap_hessian(state.gap_data, None if structure_only else state.Fg),
@@ -438,7 +460,7 @@ class CurrentObstacleGap(CurrentSurfaceGap):
         nc, nd = cells.shape
         width = nd * self.slave.gdim
         wa = self.wq[None, :] * np.einsum("ca,qa->cq", Fg[cells], self.phi)
-        blocks = (np.einsum("cq,cqbiej->cbiej", wa * d, e["d2J"])
+        blocks = (np.einsum("cq,cqbiej->cbiej", wa * d, self._element_hessians(e))
                   + np.einsum("cq,cqbi,cqej->cbiej", wa, e["dJ"], v)
                   + np.einsum("cq,cqbi,cqej->cbiej", wa, v, e["dJ"])
                   + np.einsum("cq,cq,cqij,qb,qe->cbiej", wa, e["J"], data["hess"], self.N,

@@ -109,10 +109,12 @@ class PairScene:
                                       True, length_scale=self.length_scale)
         return r["pairs"], r["gap"]
 
-    def jets(self, xs, xm, pairs, with_hessian: bool = True):
+    def jets(self, xs, xm, pairs, with_hessian: bool = True, node_weights=None):
+        """The Jet instantiation: ``current_pair_gaps`` (per node, or the
+        ``node_weights``-weighted sum per pair)."""
         gx, gc, gid = gathered(xs, self.cs)
         mx, mc, mid = gathered(xm, self.cm)
         return _kernels.current_pair_gaps(self.kind, gx, gc, gid, self.kind, mx, mc,
                                           mid + MASTER_ID_OFFSET, pairs.astype(np.int32),
                                           self.points, self.weights, self.zero,
-                                          with_hessian=with_hessian)
+                                          with_hessian=with_hessian, node_weights=node_weights)

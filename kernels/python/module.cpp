@@ -12,6 +12,7 @@
 #include <dolfinx_mortar/mortar_integrals.h>
 #include <dolfinx_mortar/surface_geometry.h>
 
+#include <optional>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -381,7 +382,8 @@ PYBIND11_MODULE(_kernels, m)
        bool opposing_normals_only,
        bool with_hessian,
        bool with_positive_part,
-       bool axisymmetric)
+       bool axisymmetric,
+       std::optional<array_t> node_weights)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
@@ -400,18 +402,21 @@ PYBIND11_MODULE(_kernels, m)
           opposing_normals_only,
           with_hessian,
           with_positive_part,
-          axisymmetric);
+          axisymmetric,
+          node_weights ? as_span(*node_weights) : std::span<const double>());
       }
       const auto np = static_cast<py::ssize_t>(pairs.size() / 2);
       const py::ssize_t ns = cs.shape(1);
+      // functions per pair: the ns c_A, or their weighted sum
+      const py::ssize_t nf = node_weights ? 1 : ns;
       const py::ssize_t nv =
         static_cast<py::ssize_t>(r.num_nodes) * xs.shape(1);
       py::dict out;
       out["nodes"] = to_numpy_as<std::int64_t>(r.nodes, { np, r.num_nodes });
-      out["value"] = to_numpy(r.value, { np, ns });
-      out["gradient"] = to_numpy(r.gradient, { np, ns, nv });
+      out["value"] = to_numpy(r.value, { np, nf });
+      out["gradient"] = to_numpy(r.gradient, { np, nf, nv });
       const py::ssize_t nh = with_hessian ? nv : 0;
-      out["hessian"] = to_numpy(r.hessian, { np, ns, nh, nh });
+      out["hessian"] = to_numpy(r.hessian, { np, nf, nh, nh });
       const py::ssize_t npp = with_positive_part ? np : 0;
       out["value_plus"] = to_numpy(r.value_plus, { npp, ns });
       out["gradient_plus"] = to_numpy(r.gradient_plus, { npp, ns, nv });
@@ -434,9 +439,11 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("with_hessian") = true,
     py::arg("with_positive_part") = false,
     py::arg("axisymmetric") = false,
+    py::arg("node_weights") = py::none(),
     "Current-configuration mortar gaps of cell pairs with exact gradients "
     "and Hessians (and, with_positive_part, the pointwise active set's "
-    "integrals of <d> with their gradients)");
+    "integrals of <d> with their gradients); with node_weights (pairs, ns), "
+    "those of the one function sum_A w_A c_A per pair instead");
 
   m.def(
     "averaged_normal_derivatives",

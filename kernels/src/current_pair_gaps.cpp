@@ -243,7 +243,8 @@ normal_derivatives(const FacetSurface& s,
 /// c_A of one pair as Jets over its slave coordinates, nodal normals and
 /// master coordinates (in that order); returns failed projections. Order 1:
 /// no Hessian (@p hess untouched). Non-empty @p value_plus: also c⁺_A =
-/// ∫ N_A ⟨d⟩ and its gradient (@p grad_plus).
+/// ∫ N_A ⟨d⟩ and its gradient (@p grad_plus). Non-empty @p node_weights
+/// (ns): the one function Σ_A w_A c_A instead of the ns c_A.
 template<int N, int Order>
 std::int64_t
 inner_pair_derivatives(FacetType slave_type,
@@ -257,6 +258,7 @@ inner_pair_derivatives(FacetType slave_type,
                        double zero,
                        bool opposing_normals_only,
                        bool axisymmetric,
+                       std::span<const double> node_weights,
                        std::span<double> value,
                        std::span<double> grad,
                        std::span<double> hess,
@@ -274,12 +276,23 @@ inner_pair_derivatives(FacetType slave_type,
   for (std::size_t i = 0; i < m.size(); ++i)
     m[i] = J::variable(master_nodes[i], v++);
   const int ns = facet_num_nodes(slave_type);
-  std::vector<J> c(ns, J(0.0)), cp(value_plus.empty() ? 0 : ns, J(0.0));
+  const bool weighted = !node_weights.empty();
+  std::vector<J> c(weighted ? 1 : ns, J(0.0)),
+    cp(value_plus.empty() ? 0 : ns, J(0.0));
   auto accumulate = [&](const SegmentPoint<J>& q)
   {
     const J wd = q.weight * q.gap;
-    for (int a = 0; a < ns; ++a)
-      c[a] += wd * q.slave_N[a];
+    if (weighted)
+    {
+      // one product per point instead of ns
+      J combination(0.0);
+      for (int a = 0; a < ns; ++a)
+        combination.add_scaled(node_weights[a], q.slave_N[a]);
+      c[0] += wd * combination;
+    }
+    else
+      for (int a = 0; a < ns; ++a)
+        c[a] += wd * q.slave_N[a];
     if (cp.empty())
       return;
     // ⟨d⟩, decided on the value (as the double segmentation's points are)
@@ -299,7 +312,7 @@ inner_pair_derivatives(FacetType slave_type,
                                                 opposing_normals_only,
                                                 axisymmetric,
                                                 accumulate);
-  for (int a = 0; a < ns; ++a)
+  for (std::size_t a = 0; a < c.size(); ++a)
   {
     value[a] = c[a].v;
     std::copy(c[a].g.begin(), c[a].g.end(), grad.data() + a * N);
@@ -325,6 +338,7 @@ using InnerFunction = std::int64_t (*)(FacetType,
                                        double,
                                        bool,
                                        bool,
+                                       std::span<const double>,
                                        std::span<double>,
                                        std::span<double>,
                                        std::span<double>,
@@ -383,7 +397,8 @@ current_pair_gaps(const FacetSurface& slave,
                   bool opposing_normals_only,
                   bool with_hessian,
                   bool with_positive_part,
-                  bool axisymmetric)
+                  bool axisymmetric,
+                  std::span<const double> node_weights)
 {
   slave.check();
   master.check();
@@ -403,6 +418,15 @@ current_pair_gaps(const FacetSurface& slave,
                                 std::to_string(gdim - 1) + ")");
   const int ns = facet_num_nodes(slave.type), nm = facet_num_nodes(master.type);
   const int N = (2 * ns + nm) * gdim;
+  const bool weighted = !node_weights.empty();
+  if (weighted and node_weights.size() != pairs.size() / 2 * ns)
+    throw std::invalid_argument("node_weights must have shape (pairs, " +
+                                std::to_string(ns) + ")");
+  if (weighted and with_positive_part)
+    throw std::invalid_argument(
+      "node_weights combine c_A only, not the positive part's c⁺_A");
+  // functions per pair: the ns c_A, or their one weighted sum
+  const int nf = weighted ? 1 : ns;
   const InnerFunction inner = with_hessian ? inner_for<2>(N) : inner_for<1>(N);
   if (!inner)
     throw std::invalid_argument(
@@ -432,8 +456,8 @@ current_pair_gaps(const FacetSurface& slave,
   std::vector<PairResult> results(P);
   PairGapDerivatives out;
   std::vector<double> xs(ns * gdim), xm(nm * gdim), normals(ns * gdim);
-  std::vector<double> value(ns), grad(ns * N),
-    hess(with_hessian ? ns * N * N : 0),
+  std::vector<double> value(nf), grad(nf * N),
+    hess(with_hessian ? nf * N * N : 0),
     value_plus(with_positive_part ? ns : 0),
     grad_plus(with_positive_part ? ns * N : 0);
   for (std::size_t p = 0; p < P; ++p)
@@ -475,6 +499,8 @@ current_pair_gaps(const FacetSurface& slave,
                                     zero,
                                     opposing_normals_only,
                                     axisymmetric,
+                                    weighted ? node_weights.subspan(p * ns, ns)
+                                             : std::span<const double>(),
                                     value,
                                     grad,
                                     hess,
@@ -514,12 +540,13 @@ current_pair_gaps(const FacetSurface& slave,
       for (int k = 0; k < gdim; ++k)
         column[(2 * ns + c) * gdim + k] = (num_slave + c) * gdim + k;
 
-    // g = Jᵀ gf for each of the ns rows of @p from
+    // g = Jᵀ gf for each row of @p from
     auto chain_gradient =
       [&](const std::vector<double>& from, std::vector<double>& to)
     {
-      to.assign(ns * K, 0.0);
-      for (int a = 0; a < ns; ++a)
+      const int rows = static_cast<int>(from.size()) / N;
+      to.assign(rows * K, 0.0);
+      for (int a = 0; a < rows; ++a)
         for (int i = 0; i < N; ++i)
         {
           const double gi = from[a * N + i];
@@ -535,14 +562,14 @@ current_pair_gaps(const FacetSurface& slave,
     r.value_plus = value_plus;
     if (with_positive_part)
       chain_gradient(grad_plus, r.gradient_plus);
-    r.gradient.resize(ns * K);
+    r.gradient.resize(nf * K);
     if (!with_hessian)
     {
       chain_gradient(grad, r.gradient);
       continue;
     }
-    r.hessian.resize(ns * K * K);
-    for (int a = 0; a < ns; ++a)
+    r.hessian.resize(nf * K * K);
+    for (int a = 0; a < nf; ++a)
       compose(N,
               K,
               std::span<const double>(grad.data() + a * N, N),
@@ -561,9 +588,9 @@ current_pair_gaps(const FacetSurface& slave,
   out.num_nodes = static_cast<int>(width);
   const std::size_t Kw = width * gdim;
   out.nodes.assign(P * width, -1);
-  out.value.assign(P * ns, 0.0);
-  out.gradient.assign(P * ns * Kw, 0.0);
-  out.hessian.assign(with_hessian ? P * ns * Kw * Kw : 0, 0.0);
+  out.value.assign(P * nf, 0.0);
+  out.gradient.assign(P * nf * Kw, 0.0);
+  out.hessian.assign(with_hessian ? P * nf * Kw * Kw : 0, 0.0);
   out.value_plus.assign(with_positive_part ? P * ns : 0, 0.0);
   out.gradient_plus.assign(with_positive_part ? P * ns * Kw : 0, 0.0);
   for (std::size_t p = 0; p < P; ++p)
@@ -571,25 +598,26 @@ current_pair_gaps(const FacetSurface& slave,
     const PairResult& r = results[p];
     const std::size_t K = r.nodes.size() * gdim;
     std::copy(r.nodes.begin(), r.nodes.end(), out.nodes.begin() + p * width);
-    std::copy(r.value.begin(), r.value.end(), out.value.begin() + p * ns);
+    std::copy(r.value.begin(), r.value.end(), out.value.begin() + p * nf);
     std::copy(r.value_plus.begin(),
               r.value_plus.end(),
               out.value_plus.begin() + p * ns);
-    for (int a = 0; a < ns; ++a)
-    {
-      if (with_positive_part)
+    if (with_positive_part)
+      for (int a = 0; a < ns; ++a)
         std::copy_n(r.gradient_plus.begin() + a * K,
                     K,
                     out.gradient_plus.begin() + (p * ns + a) * Kw);
+    for (int a = 0; a < nf; ++a)
+    {
       std::copy_n(r.gradient.begin() + a * K,
                   K,
-                  out.gradient.begin() + (p * ns + a) * Kw);
+                  out.gradient.begin() + (p * nf + a) * Kw);
       if (!with_hessian)
         continue;
       for (std::size_t i = 0; i < K; ++i)
         std::copy_n(r.hessian.begin() + (a * K + i) * K,
                     K,
-                    out.hessian.begin() + ((p * ns + a) * Kw + i) * Kw);
+                    out.hessian.begin() + ((p * nf + a) * Kw + i) * Kw);
     }
   }
   return out;

@@ -74,3 +74,24 @@ TEST(Jet, ClippingTakesTheDoubleBranchesAndCarriesTheArea)
     EXPECT_NEAR(area.g[v], (moved(h) - moved(-h)) / (2 * h), 1e-8) << v;
   }
 }
+
+TEST(Jet, AddScaledIsTheSumWithAProduct)
+{
+  // every combination of constant and variable operands, against y + c·x
+  const auto x = Jet<2>::variable(0.7, 0), y = Jet<2>::variable(1.3, 1);
+  const Jet<2> fx = f(x, y), fy = f(y, x), constant(2.5);
+  for (const Jet<2>* a : { &fx, &constant })
+    for (const Jet<2>* b : { &fy, &constant })
+    {
+      Jet<2> sum = *a;
+      sum.add_scaled(-0.3, *b);
+      const Jet<2> expected = *a + (-0.3) * *b;
+      EXPECT_EQ(sum.constant, expected.constant);
+      EXPECT_DOUBLE_EQ(sum.v, expected.v);
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+          EXPECT_DOUBLE_EQ(sum.hessian(i, j), expected.hessian(i, j));
+      EXPECT_DOUBLE_EQ(sum.g[0], expected.g[0]);
+      EXPECT_DOUBLE_EQ(sum.g[1], expected.g[1]);
+    }
+}

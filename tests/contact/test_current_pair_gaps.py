@@ -4,6 +4,7 @@ round-off, and exact gradients and Hessians (against central differences), for
 every facet type it supports, on wavy, tilted surfaces with curved pieces."""
 from __future__ import annotations
 
+import basix
 import numpy as np
 import pytest
 
@@ -88,3 +89,93 @@ def test_unsupported_facets_are_named():
         _kernels.current_pair_gaps(FT.P2_triangle, x, cells, np.arange(6), FT.P2_triangle, x,
                                    cells, np.arange(6), np.zeros((1, 2), dtype=np.int32),
                                    case.points, case.weights, case.zero)
+
+
+@pytest.mark.parametrize("kind", ["P1_line", "P2_line", "P1_triangle", "Q1_quadrilateral"])
+def test_weighted_sum_equals_the_sum_of_the_weighted_functions(kind):
+    """``node_weights``: the kernel's one function Σ_A w_A c_A per pair (what a
+    Newton matrix needs) is the weighted sum of the ns functions, value, gradient
+    and Hessian."""
+    case = PairScene(kind)
+    candidates = np.array([(i, j) for i in range(len(case.cs)) for j in range(len(case.cm))])
+    pairs, _ = case.values(case.xs, case.xm, candidates)
+    weights = np.random.default_rng(3).uniform(-1, 2, (len(pairs), case.cs.shape[1]))
+    apart = case.jets(case.xs, case.xm, pairs)
+    summed = case.jets(case.xs, case.xm, pairs, node_weights=weights)
+    assert np.array_equal(summed["nodes"], apart["nodes"])
+    for key in ("value", "gradient", "hessian"):
+        expected = np.einsum("pa,pa...->p...", weights, apart[key])
+        assert summed[key].shape == (len(pairs), 1) + apart[key].shape[2:]
+        scale = np.max(np.abs(expected))
+        assert scale > 0
+        assert np.max(np.abs(summed[key][:, 0] - expected)) <= 1e-13 * scale, key
+    # the gradients alone, too
+    alone = case.jets(case.xs, case.xm, pairs, with_hessian=False, node_weights=weights)
+    assert np.allclose(alone["gradient"], summed["gradient"], rtol=0,
+                       atol=1e-13 * np.max(np.abs(summed["gradient"])))
+
+
+def test_weights_of_the_wrong_shape_are_refused():
+    case = PairScene("P1_triangle")
+    pairs = np.array([[0, 0], [1, 1]])
+    with pytest.raises(ValueError, match="node_weights must have shape"):
+        case.jets(case.xs, case.xm, pairs, node_weights=np.ones((2, 2)))
+
+
+def _quadratic_copy(kind: str, x: np.ndarray, cells: np.ndarray):
+    """The same straight-sided cells as P2 facets (new mid-edge nodes at the
+    midpoints, Basix order), and T with N^{P1} = T N^{P2} on every cell."""
+    if kind == "P1_line":
+        edges = [(0, 1)]
+    else:
+        edges = [(1, 2), (0, 2), (0, 1)]        # Basix: the edge opposite each vertex
+    nv = cells.shape[1]
+    points, cells2 = [x], []
+    for row in cells:
+        mids = [(x[row[a]] + x[row[b]]) / 2 for a, b in edges]
+        start = sum(len(p) for p in points)
+        points.append(np.array(mids))
+        cells2.append(list(row) + list(range(start, start + len(edges))))
+    T = np.zeros((nv, nv + len(edges)))
+    T[:, :nv] = np.eye(nv)
+    for e, (a, b) in enumerate(edges):
+        T[a, nv + e] = T[b, nv + e] = 0.5
+    return np.concatenate(points), np.array(cells2, dtype=np.int32), T
+
+
+@pytest.mark.parametrize("kind", ["P1_line", "P1_triangle"])
+def test_affine_pairs_match_the_general_segmentation(kind):
+    """Affine slave and master cells take their own path (everything affine in
+    the slave plane, interpolated from the integration cells' vertices); the
+    same flat cells as P2 facets take the general one (projections at every
+    point). With a uniform normal field every integrand is a polynomial that
+    the rule integrates exactly, so both must give D, M, the gaps and the
+    areas to round-off, through N^{P1} = T N^{P2}."""
+    case = PairScene(kind)
+    gdim = case.gdim
+    normal = np.array([0.1, -1.0]) if gdim == 2 else np.array([0.1, -0.2, 1.0])
+    normal /= np.linalg.norm(normal)
+    cell = basix.CellType.interval if gdim == 2 else basix.CellType.triangle
+    points, weights = basix.make_quadrature(cell, 4)   # exact for P2 x P2 and P2 x affine
+    candidates = np.array([(i, j) for i in range(len(case.cs))
+                           for j in range(len(case.cm))], dtype=np.int32)
+
+    def integrals(kind_, xs, cs, xm, cm):
+        return _kernels.mortar_integrals(kind_, xs, cs, np.tile(normal, (len(xs), 1)), kind_,
+                                         xm, cm, candidates, points, weights, True,
+                                         length_scale=case.length_scale)
+
+    flat = integrals(case.kind, case.xs, case.cs.astype(np.int32), case.xm,
+                     case.cm.astype(np.int32))
+    xs2, cs2, Ts = _quadratic_copy(kind, case.xs, case.cs)
+    xm2, cm2, Tm = _quadratic_copy(kind, case.xm, case.cm)
+    general = integrals(FT.P2_line if gdim == 2 else FT.P2_triangle, xs2, cs2, xm2, cm2)
+    assert len(flat["pairs"]) >= 6
+    assert np.array_equal(flat["pairs"], general["pairs"])
+    expected = {"D": np.einsum("ab,pbc,dc->pad", Ts, general["D"], Ts),
+                "M": np.einsum("ab,pbc,dc->pad", Ts, general["M"], Tm),
+                "gap": general["gap"] @ Ts.T, "area": general["area"]}
+    for key, value in expected.items():
+        scale = np.max(np.abs(value))
+        assert scale > 0
+        assert np.max(np.abs(flat[key] - value)) <= 1e-13 * scale, key

@@ -52,6 +52,14 @@ facet_shape_functions(FacetType type,
                       std::span<double> N,
                       std::span<double> dN);
 
+/// Whether x(X) is affine in X (P1 lines and triangles): the facet is its
+/// own single flat piece, and a projection onto it is linear in the point.
+inline bool
+facet_is_affine(FacetType type)
+{
+  return type == FacetType::P1_line or type == FacetType::P1_triangle;
+}
+
 /// Flat sub-facets used for segmentation, as polygons of reference points
 /// of the parent (counter-clockwise in the reference cell; 2 points for
 /// lines). Linear facets have one sub-facet, the facet itself; quadratic

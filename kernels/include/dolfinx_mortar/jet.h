@@ -114,6 +114,25 @@ struct Jet
       h[k] -= b.h[k];
     return *this;
   }
+  /// *this += c·b, without the temporary of `*this += c * b`.
+  void add_scaled(double c, const Jet& b)
+  {
+    v += c * b.v;
+    if (b.constant)
+      return;
+    if (constant)
+    {
+      const double value = v;
+      *this = b;
+      *this *= c;
+      v = value;
+      return;
+    }
+    for (int i = 0; i < N; ++i)
+      g[i] += c * b.g[i];
+    for (int k = 0; k < packed; ++k)
+      h[k] += c * b.h[k];
+  }
   Jet& operator*=(double c)
   {
     v *= c;

@@ -73,6 +73,19 @@ absolute(const T& a)
   return value(a) < 0 ? T(-a) : a;
 }
 
+/// y += c·x without a temporary (a Jet's copy costs as much as its scaling).
+inline void
+add_scaled(double& y, double c, double x)
+{
+  y += c * x;
+}
+template<int N, int Order>
+void
+add_scaled(Jet<N, Order>& y, double c, const Jet<N, Order>& x)
+{
+  y.add_scaled(c, x);
+}
+
 /// Position x(X) and tangents ∂x/∂X_k of a cell given by its node
 /// coordinates @p nodes (nodes, gdim); 2D: z = 0.
 template<typename T>
@@ -158,23 +171,19 @@ make_subfacet(FacetType type,
 {
   using namespace vec3;
   const int tdim = facet_tdim(type), nn = facet_num_nodes(type);
-  std::vector<T> N(nn), dN(tdim * nn);
+  // the reference points are numbers: their shape functions are too, and
+  // the tangents are not needed
+  std::vector<double> N(nn), dN(tdim * nn);
   SubFacet<T> f;
   f.reference_centre = { 0, 0 };
   f.centre = { 0.0, 0.0, 0.0 };
-  std::array<Vec3<T>, 2> tangents;
   for (const auto& X : reference)
   {
-    const std::array<T, 2> XT = { X[0], X[1] };
-    Vec3<T> x;
-    cell_geometry<T>(type,
-                     gdim,
-                     nodes,
-                     std::span<const T>(XT.data(), tdim),
-                     N,
-                     dN,
-                     x,
-                     tangents);
+    facet_shape_functions(type, std::span(X.data(), tdim), N, dN);
+    Vec3<T> x = { 0.0, 0.0, 0.0 };
+    for (int i = 0; i < nn; ++i)
+      for (int k = 0; k < gdim; ++k)
+        add_scaled(x[k], N[i], nodes[i * gdim + k]);
     f.polygon.push_back(x);
     for (int k = 0; k < 3; ++k)
       f.centre[k] += x[k] / static_cast<double>(reference.size());
@@ -245,9 +254,7 @@ refine_projection(FacetType type,
   std::vector<T> N(nn), dN(tdim * nn);
   // On an affine cell the system is linear in (X, t): one step solves it
   // exactly, derivatives of every order included.
-  const bool affine =
-    type == FacetType::P1_line or type == FacetType::P1_triangle;
-  for (int step = 0; step < (affine ? 1 : 2); ++step)
+  for (int step = 0; step < (facet_is_affine(type) ? 1 : 2); ++step)
   {
     Vec3<T> x;
     std::array<Vec3<T>, 2> tangents;
@@ -285,6 +292,122 @@ refine_projection(FacetType type,
     t -= d2;
   }
   return { X, t };
+}
+
+/// a + a_u·u + a_v·v: a field affine in the slave plane coordinates (u, v).
+template<typename T>
+struct PlaneAffine
+{
+  T a, a_u, a_v;
+  T at(const std::array<T, 2>& p) const { return a + a_u * p[0] + a_v * p[1]; }
+};
+
+/// The reference coordinates of an affine slave cell as functions of its
+/// plane coordinates, from its vertices there (in reference order); the
+/// second is zero on a line.
+template<typename T>
+std::array<PlaneAffine<T>, 2>
+reference_from_plane(const std::vector<std::array<T, 2>>& vertices, int tdim)
+{
+  const std::array<T, 2>& P0 = vertices[0];
+  if (tdim == 1)
+  {
+    const T inverse = 1.0 / (vertices[1][0] - P0[0]);
+    return { PlaneAffine<T>{ -(P0[0] * inverse), inverse, T(0.0) },
+             PlaneAffine<T>{ T(0.0), T(0.0), T(0.0) } };
+  }
+  // X = E⁻¹ (p − P0), E = [P1 − P0, P2 − P0]: not singular, as the piece
+  // passed make_subfacet's height test
+  const T e00 = vertices[1][0] - P0[0], e01 = vertices[2][0] - P0[0];
+  const T e10 = vertices[1][1] - P0[1], e11 = vertices[2][1] - P0[1];
+  const T inverse = 1.0 / (e00 * e11 - e01 * e10);
+  const T i00 = e11 * inverse, i01 = -(e01 * inverse);
+  const T i10 = -(e10 * inverse), i11 = e00 * inverse;
+  return { PlaneAffine<T>{ -(i00 * P0[0] + i01 * P0[1]), i00, i01 },
+           PlaneAffine<T>{ -(i10 * P0[0] + i11 * P0[1]), i10, i11 } };
+}
+
+/// (X_m, t) with x_m(X_m) = x + t·n_s, x = centre + u·e1 + v·e2, for a flat
+/// master piece with vertices @p Q (in reference order) and the slave piece
+/// @p sf: the master's reference coordinates then t, as functions of (u, v).
+/// The system is linear; its matrix [∂x_m/∂X_m, −n_s] is not singular when
+/// the master's projection on the slave plane has an area, which the
+/// clipping has established.
+template<typename T>
+std::array<PlaneAffine<T>, 3>
+master_from_plane(const SubFacet<T>& sf,
+                  const std::vector<Vec3<T>>& Q,
+                  int tdim)
+{
+  using namespace vec3;
+  const Vec3<T> c = { -sf.normal[0], -sf.normal[1], -sf.normal[2] };
+  const Vec3<T> a = sub(Q[1], Q[0]);
+  // rows of the inverse matrix times its determinant
+  std::array<Vec3<T>, 3> rows;
+  T det;
+  if (tdim == 1)
+  {
+    det = a[0] * c[1] - a[1] * c[0];
+    rows[0] = { c[1], -c[0], 0.0 };
+    rows[1] = { -a[1], a[0], 0.0 };
+  }
+  else
+  {
+    const Vec3<T> b = sub(Q[2], Q[0]);
+    rows = { cross(b, c), cross(c, a), cross(a, b) };
+    det = dot(a, rows[0]);
+  }
+  const T inverse = 1.0 / det;
+  const Vec3<T> d = sub(sf.centre, Q[0]);
+  std::array<PlaneAffine<T>, 3> out;
+  for (int j = 0; j <= tdim; ++j)
+    out[j] = { dot(rows[j], d) * inverse,
+               dot(rows[j], sf.e1) * inverse,
+               dot(rows[j], sf.e2) * inverse };
+  return out;
+}
+
+/// What a point of an affine slave–master pair needs, all of it affine in
+/// the slave plane coordinates: found at the integration cells' vertices
+/// and interpolated at their quadrature points.
+template<typename T>
+struct FlatPoint
+{
+  std::array<T, 3> Ns{}, Nm{}; ///< slave and master shape functions
+  T t{};       ///< x_m = x_s + t·n_s: the gap vector is −t·n_s
+  T s{};       ///< n_s·n
+  Vec3<T> n{}; ///< the interpolated nodal normal
+  T r{};       ///< x_s[0], the radius (axisymmetric)
+};
+
+/// Σ_i l_i f_i over the first @p count of @p f (@p ns, @p nm shape
+/// functions).
+template<typename T>
+FlatPoint<T>
+interpolate(const std::array<const FlatPoint<T>*, 3>& f,
+            const std::array<double, 3>& l,
+            int count,
+            int ns,
+            int nm,
+            bool radius)
+{
+  FlatPoint<T> out;
+  auto mix = [&](T& y, auto get)
+  {
+    for (int i = 0; i < count; ++i)
+      add_scaled(y, l[i], get(*f[i]));
+  };
+  for (int a = 0; a < ns; ++a)
+    mix(out.Ns[a], [a](const FlatPoint<T>& p) -> const T& { return p.Ns[a]; });
+  for (int a = 0; a < nm; ++a)
+    mix(out.Nm[a], [a](const FlatPoint<T>& p) -> const T& { return p.Nm[a]; });
+  for (int k = 0; k < 3; ++k)
+    mix(out.n[k], [k](const FlatPoint<T>& p) -> const T& { return p.n[k]; });
+  mix(out.t, [](const FlatPoint<T>& p) -> const T& { return p.t; });
+  mix(out.s, [](const FlatPoint<T>& p) -> const T& { return p.s; });
+  if (radius)
+    mix(out.r, [](const FlatPoint<T>& p) -> const T& { return p.r; });
+  return out;
 }
 
 /// What one segment quadrature point gives its callback.
@@ -346,6 +469,9 @@ integrate_pair(FacetType slave_type,
     if (auto f = make_subfacet<T>(master_type, gdim, master_nodes, piece, zero))
       master_subfacets.push_back(std::move(*f));
 
+  // affine cells are their own single flat piece (facet_subfacets)
+  const bool flat =
+    facet_is_affine(slave_type) and facet_is_affine(master_type);
   std::int64_t failed = 0;
   for (const auto& piece : facet_subfacets(slave_type))
   {
@@ -361,6 +487,9 @@ integrate_pair(FacetType slave_type,
     std::vector<P2> slave_polygon;
     for (const Vec3<T>& x : sf->polygon)
       slave_polygon.push_back(plane_coords(x));
+    std::array<PlaneAffine<T>, 2> slave_map;
+    if (flat)
+      slave_map = reference_from_plane(slave_polygon, tdim);
 
     for (const SubFacet<T>& mf : master_subfacets)
     {
@@ -373,13 +502,16 @@ integrate_pair(FacetType slave_type,
         master_polygon.push_back(plane_coords(x));
 
       // Integration cells in plane coordinates: (origin, edge a, edge b)
-      // with measure factor; 2D cells have no edge b.
+      // with measure factor, and their vertices' indices in `vertices`; 2D
+      // cells have no edge b (and no third vertex).
       struct Cell
       {
         P2 origin, a, b;
         T measure;
+        std::array<int, 3> vertex;
       };
       std::vector<Cell> cells;
+      std::vector<P2> vertices;
       if (gdim == 2)
       {
         const T lo =
@@ -390,8 +522,14 @@ integrate_pair(FacetType slave_type,
                   larger(master_polygon[0][0], master_polygon[1][0]));
         const T length = hi - lo;
         if (value(length) > zero)
-          cells.push_back(
-            { { lo, 0.0 }, { length, 0.0 }, { 0.0, 0.0 }, length });
+        {
+          vertices = { { lo, 0.0 }, { hi, 0.0 } };
+          cells.push_back({ { lo, 0.0 },
+                            { length, 0.0 },
+                            { 0.0, 0.0 },
+                            length,
+                            { 0, 1, 0 } });
+        }
       }
       else
       {
@@ -411,10 +549,14 @@ integrate_pair(FacetType slave_type,
         P2 g = { 0.0, 0.0 };
         for (const P2& q : clipped)
           g = { g[0] + q[0] / m, g[1] + q[1] / m };
-        for (std::size_t i = 0; i < clipped.size(); ++i)
+        vertices = clipped;
+        vertices.push_back(g);
+        const int centre = static_cast<int>(clipped.size());
+        for (int i = 0; i < centre; ++i)
         {
+          const int next = (i + 1) % centre;
           const P2& q0 = clipped[i];
-          const P2& q1 = clipped[(i + 1) % clipped.size()];
+          const P2& q1 = clipped[next];
           const P2 a = { q0[0] - g[0], q0[1] - g[1] };
           const P2 b = { q1[0] - g[0], q1[1] - g[1] };
           const T twice_area = a[0] * b[1] - a[1] * b[0];
@@ -424,8 +566,75 @@ integrate_pair(FacetType slave_type,
           // round-off weight whichever way it is decided, while a
           // length-based threshold would drop the fan of a thin overlap.
           if (value(twice_area) > 0)
-            cells.push_back({ g, a, b, twice_area });
+            cells.push_back({ g, a, b, twice_area, { centre, i, next } });
         }
+      }
+
+      if (flat and !cells.empty())
+      {
+        // Both cells affine: the reference coordinates, the distance t to
+        // the master plane along n_s and the interpolated normal are affine
+        // in (u, v). They are found at the cells' vertices and interpolated
+        // at the quadrature points, where only |n| and the gap's products
+        // remain: for a Jet, a tenth of the projections' products per point.
+        // The slave point is x itself (the slave plane holds the slave
+        // cell), so x_s − x_m = −t·n_s.
+        const std::array<PlaneAffine<T>, 3> master_map =
+          master_from_plane(*sf, mf.polygon, tdim);
+        std::vector<FlatPoint<T>> at(vertices.size());
+        for (std::size_t i = 0; i < vertices.size(); ++i)
+        {
+          const P2& p = vertices[i];
+          FlatPoint<T>& f = at[i];
+          std::array<T, 2> Xs, Xm;
+          for (int k = 0; k < tdim; ++k)
+          {
+            Xs[k] = slave_map[k].at(p);
+            Xm[k] = master_map[k].at(p);
+          }
+          f.t = master_map[tdim].at(p);
+          shape_functions<T>(slave_type,
+                             std::span<const T>(Xs.data(), tdim),
+                             std::span<T>(f.Ns.data(), ns),
+                             dNs);
+          shape_functions<T>(master_type,
+                             std::span<const T>(Xm.data(), tdim),
+                             std::span<T>(f.Nm.data(), nm),
+                             dNm);
+          for (int a = 0; a < ns; ++a)
+            for (int k = 0; k < gdim; ++k)
+              f.n[k] += f.Ns[a] * slave_normals[a * gdim + k];
+          f.s = dot(sf->normal, f.n);
+          if (axisymmetric)
+            f.r = sf->centre[0] + p[0] * sf->e1[0] + p[1] * sf->e2[0];
+        }
+        for (const Cell& cell : cells)
+          for (std::size_t q = 0; q < nq; ++q)
+          {
+            const double X0 = points[q * tdim];
+            const double X1 = tdim == 2 ? points[q * tdim + 1] : 0.0;
+            const FlatPoint<T> f = interpolate<T>(
+              { &at[cell.vertex[0]], &at[cell.vertex[1]], &at[cell.vertex[2]] },
+              { 1 - X0 - X1, X0, X1 },
+              tdim + 1,
+              ns,
+              nm,
+              axisymmetric);
+            const T n_norm = norm(f.n);
+            const bool n_defined = value(n_norm) > geometric_tolerance;
+            const T d = n_defined ? T(-(f.t * f.s) / n_norm) : T(0.0);
+            T w = weights[q] * cell.measure;
+            if (axisymmetric)
+              w = w * (2 * std::numbers::pi * larger(f.r, T(0.0)));
+            on_point(SegmentPoint<T>{ w,
+                                      std::span<const T>(f.Ns.data(), ns),
+                                      std::span<const T>(f.Nm.data(), nm),
+                                      d,
+                                      f.n,
+                                      n_norm,
+                                      n_defined });
+          }
+        continue;
       }
 
       const Point3 direction = values(sf->normal);
