@@ -507,17 +507,19 @@ current_pair_gaps(const FacetSurface& slave,
                                     value_plus,
                                     grad_plus);
     // the inner variables as functions of the nodes: identity for the
-    // coordinates, the averaged normals' derivatives for the normals
-    std::vector<double> J(N * K, 0.0), normal_hessians(ns * gdim * K * K, 0.0);
-    std::vector<const double*> Hy(N, nullptr);
+    // coordinates, the averaged normals' derivatives for the normals (their
+    // Hessians are added below, on their stars' columns only)
+    std::vector<double> J(N * K, 0.0);
     std::vector<int> column(N, -1);
+    std::vector<std::vector<int>> star_columns(ns);
     for (int a = 0; a < ns; ++a)
     {
       const std::int64_t id = slave_ids[slave.cells[cs * ns + a]];
       const int own = slave_position[id];
       const NormalDerivatives& nd = normal_of(id);
       const int Ks = static_cast<int>(nd.star.size()) * gdim;
-      std::vector<int> star_column(Ks);
+      std::vector<int>& star_column = star_columns[a];
+      star_column.resize(Ks);
       for (std::size_t j = 0; j < nd.star.size(); ++j)
         for (int l = 0; l < gdim; ++l)
           star_column[j * gdim + l] = slave_position[nd.star[j]] * gdim + l;
@@ -525,15 +527,8 @@ current_pair_gaps(const FacetSurface& slave,
       {
         column[a * gdim + k] = own * gdim + k;
         const int row = (ns + a) * gdim + k;
-        double* H = normal_hessians.data() + (a * gdim + k) * K * K;
         for (int i = 0; i < Ks; ++i)
-        {
           J[row * K + star_column[i]] += nd.gradient[k * Ks + i];
-          for (int j = 0; j < Ks; ++j)
-            H[star_column[i] * K + star_column[j]] +=
-              nd.hessian[(k * Ks + i) * Ks + j];
-        }
-        Hy[row] = H;
       }
     }
     for (int c = 0; c < nm; ++c)
@@ -569,16 +564,39 @@ current_pair_gaps(const FacetSurface& slave,
       continue;
     }
     r.hessian.resize(nf * K * K);
-    for (int a = 0; a < nf; ++a)
+    const std::vector<const double*> no_second(N, nullptr);
+    for (int f = 0; f < nf; ++f)
+    {
+      std::span<double> H(r.hessian.data() + f * K * K, K * K);
       compose(N,
               K,
-              std::span<const double>(grad.data() + a * N, N),
-              std::span<const double>(hess.data() + a * N * N, N * N),
+              std::span<const double>(grad.data() + f * N, N),
+              std::span<const double>(hess.data() + f * N * N, N * N),
               column,
               J,
-              Hy,
-              std::span<double>(r.gradient.data() + a * K, K),
-              std::span<double>(r.hessian.data() + a * K * K, K * K));
+              no_second,
+              std::span<double>(r.gradient.data() + f * K, K),
+              H);
+      // + Σ (∂f/∂n) ∂²n, each normal on its own star's columns
+      for (int a = 0; a < ns; ++a)
+      {
+        const NormalDerivatives& nd =
+          normal_of(slave_ids[slave.cells[cs * ns + a]]);
+        const std::vector<int>& star_column = star_columns[a];
+        const int Ks = static_cast<int>(star_column.size());
+        for (int k = 0; k < gdim; ++k)
+        {
+          const double gf = grad[f * N + (ns + a) * gdim + k];
+          const double* Hn = nd.hessian.data() + k * Ks * Ks;
+          for (int i = 0; i < Ks; ++i)
+          {
+            double* row = H.data() + star_column[i] * K;
+            for (int j = 0; j < Ks; ++j)
+              row[star_column[j]] += gf * Hn[i * Ks + j];
+          }
+        }
+      }
+    }
   }
 
   // pad every pair to the largest variable count

@@ -126,6 +126,21 @@ mortar_integrals(const FacetSurface& slave,
   PairAccumulator acc(ns, nm);
   std::vector<double> slave_nodes(ns * gdim), normals(ns * gdim),
     master_nodes(nm * gdim);
+  // Each cell's flat pieces, built when a candidate first meets it: most
+  // candidates are rejected, and building the pieces was half their cost.
+  std::vector<std::optional<std::vector<SubFacet<double>>>> slave_pieces(
+    slave.num_cells()),
+    master_pieces(master.num_cells());
+  auto pieces_of =
+    [&](auto& cache,
+        const FacetSurface& s,
+        std::size_t c,
+        std::span<const double> nodes) -> const std::vector<SubFacet<double>>&
+  {
+    if (!cache[c])
+      cache[c] = cell_pieces<double>(s.type, gdim, nodes, zero);
+    return *cache[c];
+  };
 
   for (std::size_t p = 0; p < candidates.size() / 2; ++p)
   {
@@ -142,13 +157,15 @@ mortar_integrals(const FacetSurface& slave,
       std::copy_n(slave_normals.data() + slave.cells[cs * ns + a] * gdim,
                   gdim,
                   normals.begin() + a * gdim);
-    out.failed_projections += integrate_pair<double>(
+    out.failed_projections += integrate_pieces<double>(
       slave.type,
       master.type,
       gdim,
       slave_nodes,
       normals,
       master_nodes,
+      pieces_of(slave_pieces, slave, cs, slave_nodes),
+      pieces_of(master_pieces, master, cm, master_nodes),
       points,
       weights,
       zero,

@@ -173,13 +173,18 @@ make_subfacet(FacetType type,
   const int tdim = facet_tdim(type), nn = facet_num_nodes(type);
   // the reference points are numbers: their shape functions are too, and
   // the tangents are not needed
-  std::vector<double> N(nn), dN(tdim * nn);
+  std::array<double, 9> N;   // at most 9 nodes
+  std::array<double, 18> dN; // tdim × nodes
   SubFacet<T> f;
   f.reference_centre = { 0, 0 };
   f.centre = { 0.0, 0.0, 0.0 };
+  f.polygon.reserve(reference.size());
   for (const auto& X : reference)
   {
-    facet_shape_functions(type, std::span(X.data(), tdim), N, dN);
+    facet_shape_functions(type,
+                          std::span(X.data(), tdim),
+                          std::span(N.data(), nn),
+                          std::span(dN.data(), tdim * nn));
     Vec3<T> x = { 0.0, 0.0, 0.0 };
     for (int i = 0; i < nn; ++i)
       for (int k = 0; k < gdim; ++k)
@@ -423,62 +428,60 @@ struct SegmentPoint
   bool normal_defined;         ///< |n| above the geometric tolerance
 };
 
-/// Segment one slave–master cell pair and call @p on_point at every
-/// segment quadrature point (see mortar_integrals for the construction).
-///
-/// @param[in] slave_nodes, master_nodes Node coordinates (nodes, gdim)
-/// @param[in] slave_normals Unit nodal normals of the slave cell (nodes,
-/// gdim)
-/// @param[in] zero The zero length of every geometric decision
-/// @return The number of quadrature points whose projection failed
-/// (skipped)
+/// The non-degenerate flat pieces of a cell (facet_subfacets, make_subfacet).
+template<typename T>
+std::vector<SubFacet<T>>
+cell_pieces(FacetType type, int gdim, std::span<const T> nodes, double zero)
+{
+  std::vector<SubFacet<T>> pieces;
+  for (const auto& piece : facet_subfacets(type))
+    if (auto f = make_subfacet<T>(type, gdim, nodes, piece, zero))
+      pieces.push_back(std::move(*f));
+  return pieces;
+}
+
+/// integrate_pair with the cells' flat pieces given (cell_pieces of the
+/// same nodes): a caller that meets a cell in many pairs builds them once.
 template<typename T, typename OnPoint>
 std::int64_t
-integrate_pair(FacetType slave_type,
-               FacetType master_type,
-               int gdim,
-               std::span<const T> slave_nodes,
-               std::span<const T> slave_normals,
-               std::span<const T> master_nodes,
-               std::span<const double> points,
-               std::span<const double> weights,
-               double zero,
-               bool opposing_normals_only,
-               bool axisymmetric,
-               OnPoint&& on_point)
+integrate_pieces(FacetType slave_type,
+                 FacetType master_type,
+                 int gdim,
+                 std::span<const T> slave_nodes,
+                 std::span<const T> slave_normals,
+                 std::span<const T> master_nodes,
+                 const std::vector<SubFacet<T>>& slave_pieces,
+                 const std::vector<SubFacet<T>>& master_pieces,
+                 std::span<const double> points,
+                 std::span<const double> weights,
+                 double zero,
+                 bool opposing_normals_only,
+                 bool axisymmetric,
+                 OnPoint&& on_point)
 {
   using namespace vec3;
   using P2 = std::array<T, 2>;
   const int tdim = gdim - 1;
   const int ns = facet_num_nodes(slave_type), nm = facet_num_nodes(master_type);
   const std::size_t nq = weights.size();
-  std::vector<double> slave_values(slave_nodes.size()),
-    master_values(master_nodes.size());
-  std::transform(slave_nodes.begin(),
-                 slave_nodes.end(),
-                 slave_values.begin(),
-                 [](const T& v) { return value(v); });
-  std::transform(master_nodes.begin(),
-                 master_nodes.end(),
-                 master_values.begin(),
-                 [](const T& v) { return value(v); });
   std::vector<T> Ns(ns), dNs(tdim * ns), Nm(nm), dNm(tdim * nm);
   std::array<Vec3<T>, 2> tangents;
-  std::vector<SubFacet<T>> master_subfacets;
-  for (const auto& piece : facet_subfacets(master_type))
-    if (auto f = make_subfacet<T>(master_type, gdim, master_nodes, piece, zero))
-      master_subfacets.push_back(std::move(*f));
-
   // affine cells are their own single flat piece (facet_subfacets)
   const bool flat =
     facet_is_affine(slave_type) and facet_is_affine(master_type);
-  std::int64_t failed = 0;
-  for (const auto& piece : facet_subfacets(slave_type))
+  // the general path's Newton projections run on the values
+  std::vector<double> slave_values, master_values;
+  if (!flat)
   {
-    const auto sf =
-      make_subfacet<T>(slave_type, gdim, slave_nodes, piece, zero);
-    if (!sf)
-      continue;
+    for (const T& v : slave_nodes)
+      slave_values.push_back(value(v));
+    for (const T& v : master_nodes)
+      master_values.push_back(value(v));
+  }
+  std::int64_t failed = 0;
+  for (const SubFacet<T>& slave_piece : slave_pieces)
+  {
+    const SubFacet<T>* sf = &slave_piece;
     auto plane_coords = [&](const Vec3<T>& x) -> P2
     {
       const Vec3<T> r = sub(x, sf->centre);
@@ -491,7 +494,7 @@ integrate_pair(FacetType slave_type,
     if (flat)
       slave_map = reference_from_plane(slave_polygon, tdim);
 
-    for (const SubFacet<T>& mf : master_subfacets)
+    for (const SubFacet<T>& mf : master_pieces)
     {
       // unit normals of non-degenerate pieces: a perpendicular master
       // projects to a segment and covers nothing on either side of 0
@@ -720,6 +723,47 @@ integrate_pair(FacetType slave_type,
     }
   }
   return failed;
+}
+
+/// Segment one slave–master cell pair and call @p on_point at every
+/// segment quadrature point (see mortar_integrals for the construction).
+///
+/// @param[in] slave_nodes, master_nodes Node coordinates (nodes, gdim)
+/// @param[in] slave_normals Unit nodal normals of the slave cell (nodes,
+/// gdim)
+/// @param[in] zero The zero length of every geometric decision
+/// @return The number of quadrature points whose projection failed
+/// (skipped)
+template<typename T, typename OnPoint>
+std::int64_t
+integrate_pair(FacetType slave_type,
+               FacetType master_type,
+               int gdim,
+               std::span<const T> slave_nodes,
+               std::span<const T> slave_normals,
+               std::span<const T> master_nodes,
+               std::span<const double> points,
+               std::span<const double> weights,
+               double zero,
+               bool opposing_normals_only,
+               bool axisymmetric,
+               OnPoint&& on_point)
+{
+  return integrate_pieces<T>(
+    slave_type,
+    master_type,
+    gdim,
+    slave_nodes,
+    slave_normals,
+    master_nodes,
+    cell_pieces<T>(slave_type, gdim, slave_nodes, zero),
+    cell_pieces<T>(master_type, gdim, master_nodes, zero),
+    points,
+    weights,
+    zero,
+    opposing_normals_only,
+    axisymmetric,
+    std::forward<OnPoint>(on_point));
 }
 
 } // namespace dolfinx_mortar
