@@ -244,8 +244,9 @@ normal_derivatives(const FacetSurface& s,
 /// master coordinates (in that order); returns failed projections. Order 1:
 /// no Hessian (@p hess untouched). Non-empty @p value_plus: also c⁺_A =
 /// ∫ N_A ⟨d⟩ and its gradient (@p grad_plus). Non-empty @p node_weights
-/// (ns): the one function Σ_A w_A c_A instead of the ns c_A.
-template<int N, int Order>
+/// (ns): the one function Σ_A w_A c_A instead of the ns c_A. The geometry
+/// runs on Jets over the NG = N − ns·gdim coordinates only (integrate_pieces).
+template<int N, int NG, int Order>
 std::int64_t
 inner_pair_derivatives(FacetType slave_type,
                        FacetType master_type,
@@ -266,15 +267,21 @@ inner_pair_derivatives(FacetType slave_type,
                        std::span<double> grad_plus)
 {
   using J = Jet<N, Order>;
-  std::vector<J> s(slave_nodes.size()), n(normals.size()),
-    m(master_nodes.size());
-  int v = 0;
+  using G = Jet<NG, Order>;
+  static_assert(NG < N);
+  // J's variables: slave coordinates, normals, master coordinates; G's: the
+  // coordinates alone
+  const int split = static_cast<int>(slave_nodes.size());
+  std::vector<G> s(slave_nodes.size()), m(master_nodes.size());
+  std::vector<J> n(normals.size());
   for (std::size_t i = 0; i < s.size(); ++i)
-    s[i] = J::variable(slave_nodes[i], v++);
+    s[i] = G::variable(slave_nodes[i], i);
   for (std::size_t i = 0; i < n.size(); ++i)
-    n[i] = J::variable(normals[i], v++);
+    n[i] = J::variable(normals[i], split + i);
   for (std::size_t i = 0; i < m.size(); ++i)
-    m[i] = J::variable(master_nodes[i], v++);
+    m[i] = G::variable(master_nodes[i], split + i);
+  const int shift = static_cast<int>(normals.size());
+  auto lift = [split, shift](const G& x) { return widen<N>(x, split, shift); };
   const int ns = facet_num_nodes(slave_type);
   const bool weighted = !node_weights.empty();
   std::vector<J> c(weighted ? 1 : ns, J(0.0)),
@@ -300,18 +307,22 @@ inner_pair_derivatives(FacetType slave_type,
     for (int a = 0; a < ns; ++a)
       cp[a] += wp * q.slave_N[a];
   };
-  const std::int64_t failed = integrate_pair<J>(slave_type,
-                                                master_type,
-                                                gdim,
-                                                s,
-                                                n,
-                                                m,
-                                                points,
-                                                weights,
-                                                zero,
-                                                opposing_normals_only,
-                                                axisymmetric,
-                                                accumulate);
+  const std::int64_t failed = integrate_pieces<J, G>(
+    slave_type,
+    master_type,
+    gdim,
+    std::span<const G>(s),
+    std::span<const J>(n),
+    std::span<const G>(m),
+    cell_pieces<G>(slave_type, gdim, std::span<const G>(s), zero),
+    cell_pieces<G>(master_type, gdim, std::span<const G>(m), zero),
+    points,
+    weights,
+    zero,
+    opposing_normals_only,
+    axisymmetric,
+    lift,
+    accumulate);
   for (std::size_t a = 0; a < c.size(); ++a)
   {
     value[a] = c[a].v;
@@ -345,30 +356,43 @@ using InnerFunction = std::int64_t (*)(FacetType,
                                        std::span<double>,
                                        std::span<double>);
 
-/// The instantiation for N variables: 2D lines of degree 1 or 2 (12–18),
-/// 3D P1 triangles and Q1 quadrilaterals (27–36).
+/// The instantiation for N variables of which NG are coordinates: 2D lines
+/// of degree 1 or 2 (12–18), 3D P1 triangles and Q1 quadrilaterals (27–36).
 template<int Order>
 InnerFunction
-inner_for(int N)
+inner_for(int N, int NG)
 {
+  constexpr std::array<std::pair<int, int>, 8> instantiated = { { { 12, 8 },
+                                                                  { 14, 10 },
+                                                                  { 16, 10 },
+                                                                  { 18, 12 },
+                                                                  { 27, 18 },
+                                                                  { 30, 21 },
+                                                                  { 33, 21 },
+                                                                  { 36,
+                                                                    24 } } };
+  if (std::find(instantiated.begin(),
+                instantiated.end(),
+                std::pair<int, int>(N, NG)) == instantiated.end())
+    return nullptr;
   switch (N)
   {
     case 12:
-      return &inner_pair_derivatives<12, Order>;
+      return &inner_pair_derivatives<12, 8, Order>;
     case 14:
-      return &inner_pair_derivatives<14, Order>;
+      return &inner_pair_derivatives<14, 10, Order>;
     case 16:
-      return &inner_pair_derivatives<16, Order>;
+      return &inner_pair_derivatives<16, 10, Order>;
     case 18:
-      return &inner_pair_derivatives<18, Order>;
+      return &inner_pair_derivatives<18, 12, Order>;
     case 27:
-      return &inner_pair_derivatives<27, Order>;
+      return &inner_pair_derivatives<27, 18, Order>;
     case 30:
-      return &inner_pair_derivatives<30, Order>;
+      return &inner_pair_derivatives<30, 21, Order>;
     case 33:
-      return &inner_pair_derivatives<33, Order>;
+      return &inner_pair_derivatives<33, 21, Order>;
     case 36:
-      return &inner_pair_derivatives<36, Order>;
+      return &inner_pair_derivatives<36, 24, Order>;
   }
   return nullptr;
 }
@@ -427,7 +451,9 @@ current_pair_gaps(const FacetSurface& slave,
       "node_weights combine c_A only, not the positive part's c⁺_A");
   // functions per pair: the ns c_A, or their one weighted sum
   const int nf = weighted ? 1 : ns;
-  const InnerFunction inner = with_hessian ? inner_for<2>(N) : inner_for<1>(N);
+  const int NG = (ns + nm) * gdim;
+  const InnerFunction inner =
+    with_hessian ? inner_for<2>(N, NG) : inner_for<1>(N, NG);
   if (!inner)
     throw std::invalid_argument(
       "exact derivatives of the current-configuration mortar gap are "

@@ -157,13 +157,13 @@ mortar_integrals(const FacetSurface& slave,
       std::copy_n(slave_normals.data() + slave.cells[cs * ns + a] * gdim,
                   gdim,
                   normals.begin() + a * gdim);
-    out.failed_projections += integrate_pieces<double>(
+    out.failed_projections += integrate_pieces<double, double>(
       slave.type,
       master.type,
       gdim,
-      slave_nodes,
-      normals,
-      master_nodes,
+      std::span<const double>(slave_nodes),
+      std::span<const double>(normals),
+      std::span<const double>(master_nodes),
       pieces_of(slave_pieces, slave, cs, slave_nodes),
       pieces_of(master_pieces, master, cm, master_nodes),
       points,
@@ -171,6 +171,7 @@ mortar_integrals(const FacetSurface& slave,
       zero,
       options.opposing_normals_only,
       options.axisymmetric,
+      [](double x) { return x; },
       [&](const SegmentPoint<double>& q)
       {
         acc.add(q.weight, q.slave_N, q.master_N, q.gap);

@@ -95,3 +95,20 @@ TEST(Jet, AddScaledIsTheSumWithAProduct)
       EXPECT_DOUBLE_EQ(sum.g[1], expected.g[1]);
     }
 }
+
+TEST(Jet, WidenedEqualsTheComputationOverMoreVariables)
+{
+  // f over (x, y) widened to four variables with y moved to the last: the
+  // same as f computed over four variables directly
+  const Jet<2> narrow = f(Jet<2>::variable(0.7, 0), Jet<2>::variable(1.3, 1));
+  const Jet<4> wide = widen<4>(narrow, 1, 2);
+  const Jet<4> direct = f(Jet<4>::variable(0.7, 0), Jet<4>::variable(1.3, 3));
+  EXPECT_DOUBLE_EQ(wide.v, direct.v);
+  for (int i = 0; i < 4; ++i)
+  {
+    EXPECT_DOUBLE_EQ(wide.g[i], direct.g[i]) << i;
+    for (int j = 0; j < 4; ++j)
+      EXPECT_DOUBLE_EQ(wide.hessian(i, j), direct.hessian(i, j)) << i << j;
+  }
+  EXPECT_TRUE(widen<4>(Jet<2>(3.0), 1, 2).constant);
+}

@@ -202,6 +202,36 @@ struct Jet
   friend Jet hypot(const Jet& a, const Jet& b) { return sqrt(a * a + b * b); }
 };
 
+/// @p x as a Jet over M ≥ N variables, variable i becoming variable
+/// i < split ? i : i + shift (order-preserving, so the packed Hessian's
+/// upper triangle stays the upper triangle): a result over fewer variables
+/// joins a computation over more.
+template<int M, int N, int Order>
+Jet<M, Order>
+widen(const Jet<N, Order>& x, int split, int shift)
+{
+  static_assert(M >= N);
+  Jet<M, Order> y(x.v);
+  if (x.constant)
+    return y;
+  y.constant = false;
+  auto to = [split, shift](int i) { return i < split ? i : i + shift; };
+  for (int i = 0; i < N; ++i)
+    y.g[to(i)] = x.g[i];
+  if constexpr (Order == 2)
+  {
+    int k = 0;
+    for (int i = 0; i < N; ++i)
+    {
+      const int I = to(i);
+      double* row = y.h.data() + I * M - I * (I - 1) / 2 - I;
+      for (int j = i; j < N; ++j, ++k)
+        row[to(j)] = x.h[k];
+    }
+  }
+  return y;
+}
+
 /// The value of a scalar: itself for double, the value part of a Jet. Every
 /// branch of a templated algorithm is decided on values, so that the double
 /// and the Jet instantiations take the same branches.
