@@ -55,7 +55,7 @@ averaged_normal_derivatives(const FacetSurface& s,
                             std::span<const std::int64_t> ids,
                             std::int64_t node);
 
-/// c_A and its derivatives for every pair: integrate_pair instantiated with
+/// c_A and its derivatives for every pair: integrate_pieces instantiated with
 /// a Jet over the pair's slave nodes, nodal normals and master nodes, then
 /// chained through the normals to the nodes around the slave cell.
 ///

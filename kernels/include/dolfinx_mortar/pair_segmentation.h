@@ -440,8 +440,18 @@ cell_pieces(FacetType type, int gdim, std::span<const T> nodes, double zero)
   return pieces;
 }
 
-/// integrate_pair with the cells' flat pieces given (cell_pieces of the
-/// same nodes): a caller that meets a cell in many pairs builds them once.
+/// Segment one slave–master cell pair and call @p on_point at every
+/// segment quadrature point (see mortar_integrals for the construction).
+///
+/// @param[in] slave_nodes, master_nodes Node coordinates (nodes, gdim)
+/// @param[in] slave_normals Unit nodal normals of the slave cell (nodes,
+/// gdim)
+/// @param[in] slave_pieces, master_pieces cell_pieces of the same nodes: a
+/// caller that meets a cell in many pairs builds them once
+/// @param[in] zero The zero length of every geometric decision
+/// @param[in] lift G → T (the identity for values)
+/// @return The number of quadrature points whose projection failed
+/// (skipped)
 ///
 /// The geometry (pieces, clipping, projections) is computed in the scalar
 /// type @p G of the node coordinates, and only what meets the nodal
@@ -746,48 +756,6 @@ integrate_pieces(FacetType slave_type,
     }
   }
   return failed;
-}
-
-/// Segment one slave–master cell pair and call @p on_point at every
-/// segment quadrature point (see mortar_integrals for the construction).
-///
-/// @param[in] slave_nodes, master_nodes Node coordinates (nodes, gdim)
-/// @param[in] slave_normals Unit nodal normals of the slave cell (nodes,
-/// gdim)
-/// @param[in] zero The zero length of every geometric decision
-/// @return The number of quadrature points whose projection failed
-/// (skipped)
-template<typename T, typename OnPoint>
-std::int64_t
-integrate_pair(FacetType slave_type,
-               FacetType master_type,
-               int gdim,
-               std::span<const T> slave_nodes,
-               std::span<const T> slave_normals,
-               std::span<const T> master_nodes,
-               std::span<const double> points,
-               std::span<const double> weights,
-               double zero,
-               bool opposing_normals_only,
-               bool axisymmetric,
-               OnPoint&& on_point)
-{
-  return integrate_pieces<T, T>(
-    slave_type,
-    master_type,
-    gdim,
-    slave_nodes,
-    slave_normals,
-    master_nodes,
-    cell_pieces<T>(slave_type, gdim, slave_nodes, zero),
-    cell_pieces<T>(master_type, gdim, master_nodes, zero),
-    points,
-    weights,
-    zero,
-    opposing_normals_only,
-    axisymmetric,
-    [](const T& x) -> const T& { return x; },
-    std::forward<OnPoint>(on_point));
 }
 
 } // namespace dolfinx_mortar
