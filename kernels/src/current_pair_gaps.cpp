@@ -321,6 +321,7 @@ inner_pair_derivatives(FacetType slave_type,
     zero,
     opposing_normals_only,
     axisymmetric,
+    false, // c_A needs no master shape functions
     lift,
     accumulate);
   for (std::size_t a = 0; a < c.size(); ++a)

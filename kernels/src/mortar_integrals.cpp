@@ -171,6 +171,7 @@ mortar_integrals(const FacetSurface& slave,
       zero,
       options.opposing_normals_only,
       options.axisymmetric,
+      true,
       [](double x) { return x; },
       [&](const SegmentPoint<double>& q)
       {

@@ -421,12 +421,34 @@ struct SegmentPoint
 {
   T weight;                    ///< quadrature weight × measure
   std::span<const T> slave_N;  ///< N_A at the slave point
-  std::span<const T> master_N; ///< N^m_C at the master point
+  std::span<const T> master_N; ///< N^m_C at the master point (if asked for)
   T gap;                       ///< d = (x_s − x_m)·n/|n|
   Vec3<T> normal;              ///< interpolated nodal normal n (not unit)
   T normal_norm;               ///< |n|
   bool normal_defined;         ///< |n| above the geometric tolerance
 };
+
+/// Whether the bounding boxes of two plane polygons are more than @p margin
+/// apart along an axis (on the values).
+template<typename Point>
+bool
+boxes_apart(const std::vector<Point>& a,
+            const std::vector<Point>& b,
+            double margin)
+{
+  for (int k = 0; k < 2; ++k)
+  {
+    double lo_a = value(a[0][k]), hi_a = lo_a, lo_b = value(b[0][k]),
+           hi_b = lo_b;
+    for (const Point& p : a)
+      lo_a = std::min(lo_a, value(p[k])), hi_a = std::max(hi_a, value(p[k]));
+    for (const Point& p : b)
+      lo_b = std::min(lo_b, value(p[k])), hi_b = std::max(hi_b, value(p[k]));
+    if (lo_b > hi_a + margin or lo_a > hi_b + margin)
+      return true;
+  }
+  return false;
+}
 
 /// The non-degenerate flat pieces of a cell (facet_subfacets, make_subfacet).
 template<typename T>
@@ -449,6 +471,8 @@ cell_pieces(FacetType type, int gdim, std::span<const T> nodes, double zero)
 /// @param[in] slave_pieces, master_pieces cell_pieces of the same nodes: a
 /// caller that meets a cell in many pairs builds them once
 /// @param[in] zero The zero length of every geometric decision
+/// @param[in] with_master_N Give the callback the master's shape
+/// functions (else SegmentPoint::master_N is empty)
 /// @param[in] lift G → T (the identity for values)
 /// @return The number of quadrature points whose projection failed
 /// (skipped)
@@ -473,6 +497,7 @@ integrate_pieces(FacetType slave_type,
                  double zero,
                  bool opposing_normals_only,
                  bool axisymmetric,
+                 bool with_master_N,
                  Lift&& lift,
                  OnPoint&& on_point)
 {
@@ -481,6 +506,7 @@ integrate_pieces(FacetType slave_type,
   const int tdim = gdim - 1;
   const int ns = facet_num_nodes(slave_type), nm = facet_num_nodes(master_type);
   const std::size_t nq = weights.size();
+  const int nm_out = with_master_N ? nm : 0;
   std::vector<G> NsG(ns), dNs(tdim * ns), NmG(nm), dNm(tdim * nm);
   std::vector<T> Ns(ns), Nm(nm);
   std::array<Vec3<G>, 2> tangents;
@@ -508,14 +534,11 @@ integrate_pieces(FacetType slave_type,
     std::vector<P2> slave_polygon;
     for (const Vec3<G>& x : sf->polygon)
       slave_polygon.push_back(plane_coords(x));
+    // the flat path's slave map and normal, made when a piece pair first
+    // overlaps (most candidate pairs do not)
     std::array<PlaneAffine<G>, 2> slave_map;
-    Vec3<T> slave_normal;
-    if (flat)
-    {
-      slave_map = reference_from_plane(slave_polygon, tdim);
-      for (int k = 0; k < 3; ++k)
-        slave_normal[k] = lift(sf->normal[k]);
-    }
+    Vec3<T> slave_normal{};
+    bool slave_map_made = false;
 
     for (const SubFacet<G>& mf : master_pieces)
     {
@@ -563,6 +586,11 @@ integrate_pieces(FacetType slave_type,
         // construction; the master one is usually clockwise (it faces the
         // slave) and must be turned for clipping. It is not degenerate, so
         // the sign of its area is not round-off.
+        // Boxes more than twice the zero length apart cannot overlap by more
+        // than the clipping's tolerance: the rejection the clipping would
+        // reach, at a fraction of its cost (most candidates end here).
+        if (boxes_apart(slave_polygon, master_polygon, 2 * zero))
+          continue;
         if (value(signed_area(master_polygon)) < 0)
           std::reverse(master_polygon.begin(), master_polygon.end());
         const auto clipped = clip_polygon(slave_polygon, master_polygon, zero);
@@ -605,6 +633,13 @@ integrate_pieces(FacetType slave_type,
         // remain: for a Jet, a tenth of the projections' products per point.
         // The slave point is x itself (the slave plane holds the slave
         // cell), so x_s − x_m = −t·n_s.
+        if (!slave_map_made)
+        {
+          slave_map = reference_from_plane(slave_polygon, tdim);
+          for (int k = 0; k < 3; ++k)
+            slave_normal[k] = lift(sf->normal[k]);
+          slave_map_made = true;
+        }
         const std::array<PlaneAffine<G>, 3> master_map =
           master_from_plane(*sf, mf.polygon, tdim);
         std::vector<FlatPoint<T>> at(vertices.size());
@@ -614,19 +649,21 @@ integrate_pieces(FacetType slave_type,
           FlatPoint<T>& f = at[i];
           std::array<G, 2> Xs, Xm;
           for (int k = 0; k < tdim; ++k)
-          {
             Xs[k] = slave_map[k].at(p);
-            Xm[k] = master_map[k].at(p);
-          }
           f.t = lift(master_map[tdim].at(p));
           shape_functions<G>(
             slave_type, std::span<const G>(Xs.data(), tdim), NsG, dNs);
-          shape_functions<G>(
-            master_type, std::span<const G>(Xm.data(), tdim), NmG, dNm);
           for (int a = 0; a < ns; ++a)
             f.Ns[a] = lift(NsG[a]);
-          for (int c = 0; c < nm; ++c)
-            f.Nm[c] = lift(NmG[c]);
+          if (with_master_N)
+          {
+            for (int k = 0; k < tdim; ++k)
+              Xm[k] = master_map[k].at(p);
+            shape_functions<G>(
+              master_type, std::span<const G>(Xm.data(), tdim), NmG, dNm);
+            for (int c = 0; c < nm; ++c)
+              f.Nm[c] = lift(NmG[c]);
+          }
           for (int a = 0; a < ns; ++a)
             for (int k = 0; k < gdim; ++k)
               f.n[k] += f.Ns[a] * slave_normals[a * gdim + k];
@@ -646,7 +683,7 @@ integrate_pieces(FacetType slave_type,
               { 1 - X0 - X1, X0, X1 },
               tdim + 1,
               ns,
-              nm,
+              nm_out,
               axisymmetric);
             const T n_norm = norm(f.n);
             const bool n_defined = value(n_norm) > geometric_tolerance;
@@ -656,7 +693,7 @@ integrate_pieces(FacetType slave_type,
               w = w * (2 * std::numbers::pi * larger(f.r, T(0.0)));
             on_point(SegmentPoint<T>{ w,
                                       std::span<const T>(f.Ns.data(), ns),
-                                      std::span<const T>(f.Nm.data(), nm),
+                                      std::span<const T>(f.Nm.data(), nm_out),
                                       d,
                                       f.n,
                                       n_norm,
@@ -731,7 +768,7 @@ integrate_pieces(FacetType slave_type,
                            tangents);
           for (int a = 0; a < ns; ++a)
             Ns[a] = lift(NsG[a]);
-          for (int c = 0; c < nm; ++c)
+          for (int c = 0; c < nm_out; ++c)
             Nm[c] = lift(NmG[c]);
           Vec3<T> n = { 0.0, 0.0, 0.0 };
           for (int a = 0; a < ns; ++a)
@@ -751,7 +788,13 @@ integrate_pieces(FacetType slave_type,
           // point's radius (clamped: a node on the axis may sit at −1e-17)
           if (axisymmetric)
             w = w * (2 * std::numbers::pi * larger(lift(xs[0]), T(0.0)));
-          on_point(SegmentPoint<T>{ w, Ns, Nm, d, n, n_norm, n_defined });
+          on_point(SegmentPoint<T>{ w,
+                                    Ns,
+                                    std::span<const T>(Nm.data(), nm_out),
+                                    d,
+                                    n,
+                                    n_norm,
+                                    n_defined });
         }
     }
   }
