@@ -83,8 +83,9 @@ unpack(const Jet<N>& x, double& v, double* g, double* H)
 }
 
 /// The size-weighted normal of a cell at its node @p position, with its
-/// derivatives with respect to the cell's M = nodes·gdim coordinates.
-template<int M>
+/// derivatives with respect to the cell's M = nodes·gdim coordinates (the
+/// second ones with Order 2 only; @p hess untouched otherwise).
+template<int M, int Order>
 void
 cell_normal_jet(FacetType type,
                 int gdim,
@@ -94,23 +95,30 @@ cell_normal_jet(FacetType type,
                 double* grad,
                 double* hess)
 {
+  using J = Jet<M, Order>;
   const int nn = facet_num_nodes(type), tdim = facet_tdim(type);
-  std::vector<Jet<M>> x(M), N(nn), dN(tdim * nn);
+  std::vector<J> x(M), N(nn), dN(tdim * nn);
   for (int i = 0; i < M; ++i)
-    x[i] = Jet<M>::variable(nodes[i], i);
+    x[i] = J::variable(nodes[i], i);
   const std::vector<double> reference = facet_reference_nodes(type);
-  const std::array<Jet<M>, 2> X = { reference[position * tdim],
-                                    tdim == 2 ? reference[position * tdim + 1]
-                                              : 0.0 };
-  Vec3<Jet<M>> p;
-  std::array<Vec3<Jet<M>>, 2> t;
-  cell_geometry<Jet<M>>(
-    type, gdim, x, std::span<const Jet<M>>(X.data(), tdim), N, dN, p, t);
-  const Vec3<Jet<M>> n = size_weighted_normal(gdim, t);
+  const std::array<J, 2> X = { reference[position * tdim],
+                               tdim == 2 ? reference[position * tdim + 1]
+                                         : 0.0 };
+  Vec3<J> p;
+  std::array<Vec3<J>, 2> t;
+  cell_geometry<J>(
+    type, gdim, x, std::span<const J>(X.data(), tdim), N, dN, p, t);
+  const Vec3<J> n = size_weighted_normal(gdim, t);
   for (int k = 0; k < gdim; ++k)
-    unpack(n[k], value_out[k], grad + k * M, hess + k * M * M);
+  {
+    value_out[k] = n[k].v;
+    std::copy(n[k].g.begin(), n[k].g.end(), grad + k * M);
+    if constexpr (Order == 2)
+      unpack(n[k], value_out[k], grad + k * M, hess + k * M * M);
+  }
 }
 
+template<int Order>
 void
 cell_normal_derivatives(FacetType type,
                         int gdim,
@@ -123,19 +131,19 @@ cell_normal_derivatives(FacetType type,
   switch (facet_num_nodes(type) * gdim)
   {
     case 4:
-      return cell_normal_jet<4>(type, gdim, nodes, position, v, g, h);
+      return cell_normal_jet<4, Order>(type, gdim, nodes, position, v, g, h);
     case 6:
-      return cell_normal_jet<6>(type, gdim, nodes, position, v, g, h);
+      return cell_normal_jet<6, Order>(type, gdim, nodes, position, v, g, h);
     case 9:
-      return cell_normal_jet<9>(type, gdim, nodes, position, v, g, h);
+      return cell_normal_jet<9, Order>(type, gdim, nodes, position, v, g, h);
     case 12:
-      return cell_normal_jet<12>(type, gdim, nodes, position, v, g, h);
+      return cell_normal_jet<12, Order>(type, gdim, nodes, position, v, g, h);
     case 18:
-      return cell_normal_jet<18>(type, gdim, nodes, position, v, g, h);
+      return cell_normal_jet<18, Order>(type, gdim, nodes, position, v, g, h);
     case 24:
-      return cell_normal_jet<24>(type, gdim, nodes, position, v, g, h);
+      return cell_normal_jet<24, Order>(type, gdim, nodes, position, v, g, h);
     case 27:
-      return cell_normal_jet<27>(type, gdim, nodes, position, v, g, h);
+      return cell_normal_jet<27, Order>(type, gdim, nodes, position, v, g, h);
   }
   throw std::logic_error("no cell normal instantiation for " + to_string(type));
 }
@@ -156,11 +164,14 @@ node_cells(const FacetSurface& s, std::span<const std::int64_t> ids)
   return around;
 }
 
+/// averaged_normal_derivatives; without @p with_hessian the Hessian is
+/// left empty (and its cells' second derivatives are not computed).
 NormalDerivatives
 normal_derivatives(const FacetSurface& s,
                    std::span<const std::int64_t> ids,
                    const Adjacency& around,
-                   std::int64_t node)
+                   std::int64_t node,
+                   bool with_hessian = true)
 {
   const auto it = around.find(node);
   if (it == around.end())
@@ -177,15 +188,21 @@ normal_derivatives(const FacetSurface& s,
         out.star.push_back(id);
     }
   const int K = static_cast<int>(out.star.size()) * gdim;
-  std::vector<double> sv(3, 0.0), ds(gdim * K, 0.0), d2s(gdim * K * K, 0.0);
-  std::vector<double> nodes(M), v(gdim), g(gdim * M), h(gdim * M * M);
+  std::vector<double> sv(3, 0.0), ds(gdim * K, 0.0),
+    d2s(with_hessian ? gdim * K * K : 0, 0.0);
+  std::vector<double> nodes(M), v(gdim), g(gdim * M),
+    h(with_hessian ? gdim * M * M : 0);
   std::vector<int> column(M);
   double largest = 0; // the largest cell normal: a length (2D) or an area
   for (const auto& [c, i] : it->second)
   {
     gather_cell_nodes(s, c, nodes);
-    cell_normal_derivatives(
-      s.type, gdim, nodes, i, v.data(), g.data(), h.data());
+    if (with_hessian)
+      cell_normal_derivatives<2>(
+        s.type, gdim, nodes, i, v.data(), g.data(), h.data());
+    else
+      cell_normal_derivatives<1>(
+        s.type, gdim, nodes, i, v.data(), g.data(), h.data());
     for (int j = 0; j < nn; ++j)
       for (int k = 0; k < gdim; ++k)
         column[j * gdim + k] = position[ids[s.cells[c * nn + j]]] * gdim + k;
@@ -197,8 +214,9 @@ normal_derivatives(const FacetSurface& s,
       for (int a = 0; a < M; ++a)
       {
         ds[k * K + column[a]] += g[k * M + a];
-        for (int b = 0; b < M; ++b)
-          d2s[(k * K + column[a]) * K + column[b]] += h[(k * M + a) * M + b];
+        if (with_hessian)
+          for (int b = 0; b < M; ++b)
+            d2s[(k * K + column[a]) * K + column[b]] += h[(k * M + a) * M + b];
       }
     }
     largest = std::max(largest, std::sqrt(length));
@@ -214,10 +232,12 @@ normal_derivatives(const FacetSurface& s,
     throw std::invalid_argument("the normals around surface node " +
                                 std::to_string(node) + " cancel");
   out.gradient.assign(gdim * K, 0.0);
-  out.hessian.assign(gdim * K * K, 0.0);
-  std::vector<const double*> Hy(gdim);
-  for (int k = 0; k < gdim; ++k)
-    Hy[k] = d2s.data() + k * K * K;
+  // without the Hessian, compose's is computed into scratch and dropped
+  std::vector<double> hessian(gdim * K * K, 0.0);
+  std::vector<const double*> Hy(gdim, nullptr);
+  if (with_hessian)
+    for (int k = 0; k < gdim; ++k)
+      Hy[k] = d2s.data() + k * K * K;
   const std::vector<int> dense_rows(gdim, -1);
   for (int k = 0; k < gdim; ++k)
   {
@@ -235,8 +255,10 @@ normal_derivatives(const FacetSurface& s,
             ds,
             Hy,
             std::span<double>(out.gradient.data() + k * K, K),
-            std::span<double>(out.hessian.data() + k * K * K, K * K));
+            std::span<double>(hessian.data() + k * K * K, K * K));
   }
+  if (with_hessian)
+    out.hessian = std::move(hessian);
   return out;
 }
 
@@ -468,9 +490,11 @@ current_pair_gaps(const FacetSurface& slave,
   {
     auto it = normal_cache.find(id);
     if (it == normal_cache.end())
-      it = normal_cache
-             .emplace(id, normal_derivatives(slave, slave_ids, around, id))
-             .first;
+      it =
+        normal_cache
+          .emplace(
+            id, normal_derivatives(slave, slave_ids, around, id, with_hessian))
+          .first;
     return it->second;
   };
 
