@@ -111,10 +111,13 @@ cell_normal_jet(FacetType type,
   const Vec3<J> n = size_weighted_normal(gdim, t);
   for (int k = 0; k < gdim; ++k)
   {
-    value_out[k] = n[k].v;
-    std::copy(n[k].g.begin(), n[k].g.end(), grad + k * M);
     if constexpr (Order == 2)
       unpack(n[k], value_out[k], grad + k * M, hess + k * M * M);
+    else
+    {
+      value_out[k] = n[k].v;
+      std::copy(n[k].g.begin(), n[k].g.end(), grad + k * M);
+    }
   }
 }
 
@@ -385,37 +388,27 @@ template<int Order>
 InnerFunction
 inner_for(int N, int NG)
 {
-  constexpr std::array<std::pair<int, int>, 8> instantiated = { { { 12, 8 },
-                                                                  { 14, 10 },
-                                                                  { 16, 10 },
-                                                                  { 18, 12 },
-                                                                  { 27, 18 },
-                                                                  { 30, 21 },
-                                                                  { 33, 21 },
-                                                                  { 36,
-                                                                    24 } } };
-  if (std::find(instantiated.begin(),
-                instantiated.end(),
-                std::pair<int, int>(N, NG)) == instantiated.end())
-    return nullptr;
+  // NG is fixed by N for every instantiated pair type; the check guards it
+  auto checked = [NG](int ng, InnerFunction f)
+  { return NG == ng ? f : nullptr; };
   switch (N)
   {
     case 12:
-      return &inner_pair_derivatives<12, 8, Order>;
+      return checked(8, &inner_pair_derivatives<12, 8, Order>);
     case 14:
-      return &inner_pair_derivatives<14, 10, Order>;
+      return checked(10, &inner_pair_derivatives<14, 10, Order>);
     case 16:
-      return &inner_pair_derivatives<16, 10, Order>;
+      return checked(10, &inner_pair_derivatives<16, 10, Order>);
     case 18:
-      return &inner_pair_derivatives<18, 12, Order>;
+      return checked(12, &inner_pair_derivatives<18, 12, Order>);
     case 27:
-      return &inner_pair_derivatives<27, 18, Order>;
+      return checked(18, &inner_pair_derivatives<27, 18, Order>);
     case 30:
-      return &inner_pair_derivatives<30, 21, Order>;
+      return checked(21, &inner_pair_derivatives<30, 21, Order>);
     case 33:
-      return &inner_pair_derivatives<33, 21, Order>;
+      return checked(21, &inner_pair_derivatives<33, 21, Order>);
     case 36:
-      return &inner_pair_derivatives<36, 24, Order>;
+      return checked(24, &inner_pair_derivatives<36, 24, Order>);
   }
   return nullptr;
 }
