@@ -58,7 +58,7 @@ def main() -> None:
                      "contact_over_bulk": contact / bulk, "p0_error": figures["p0_error"],
                      "a_error": figures["a_error"]})
         if comm.rank == 0:
-            print(rows[-1], flush=True)
+            print(rows[-1], {k: round(v, 3) for k, v in t.items()}, flush=True)
     if comm.rank == 0:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         write_csv(args.out + ".csv", rows, COLUMNS)

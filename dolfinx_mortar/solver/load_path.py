@@ -25,6 +25,7 @@ from dolfinx_mortar.solver.convergence import (ContactDivergenceError, Equilibri
 from dolfinx_mortar.solver.contact_block_pc import ContactBlockPreconditioner
 from dolfinx_mortar.solver.linear_solver import (DIRECT_OPTIONS, choose_linear_solver,
                                                  iterative_options)
+from dolfinx_mortar.solver.line_search import FullStepFirst
 from dolfinx_mortar.solver.load_stepping import LoadStepper
 from dolfinx_mortar.solver.newton_start import PathExtrapolation, close_gaps
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
@@ -73,25 +74,24 @@ class LoadPathSolver:
         self._user_options: dict[str, bool] = {}
         #: wall time (s) inside SNES solves, callbacks included (accumulated)
         self.timings: dict[str, float] = {}
+        #: the current-surface phase's line search of the last :meth:`create_snes`
+        #: (None where the library does not choose it: :meth:`library_line_search`)
+        self.line_search: Optional[FullStepFirst] = None
 
     @property
     def contacts(self):
         return self.problem.contacts
 
     def default_options(self) -> dict:
-        """The solver's defaults (:data:`DEFAULT_OPTIONS`), with the ``l2`` line
-        search when a term uses the current configuration.
+        """The solver's defaults (:data:`DEFAULT_OPTIONS`), with the iterative
+        linear solver's options where it was chosen.
 
-        There a pressure far above the final one (the first Newton steps of a
-        contact problem overshoot) brings a geometric stiffness of its own
-        size: full steps (``basic``) diverged to NaN on the first slide step of
-        a press-and-slide run and cycled on Hertz 2D; ``bt`` slid well but on
-        Hertz 2D against an elastic block shrank its steps to 10% and stalled
-        in every cut-back; ``l2`` converged on both.
+        The line search is ``basic``. On the current surface
+        (``basis_configuration="current"``) it runs
+        :class:`~dolfinx_mortar.solver.line_search.FullStepFirst` as its
+        pre-check, unless the user chose a line search (:meth:`library_line_search`).
         """
         defaults = dict(DEFAULT_OPTIONS)
-        if any(term.basis_configuration == "current" for term in self.contacts):
-            defaults["snes_linesearch_type"] = "l2"
         if self.linear_solver == "iterative":
             for key in DIRECT_OPTIONS:
                 defaults.pop(key)
@@ -117,6 +117,10 @@ class LoadPathSolver:
         self.problem.configure_snes(snes)
         snes.setConvergenceHistory()
         self._configure_from_options(snes)
+        self.line_search = (FullStepFirst(self.problem, snes)
+                            if self.library_line_search() else None)
+        if self.line_search is not None:
+            self.line_search.attach()
         return snes
 
     def _configure_from_options(self, snes: PETSc.SNES) -> None:
@@ -127,20 +131,18 @@ class LoadPathSolver:
         self._configure_preconditioner(snes.getKSP())
         self.problem.configure_ksp(snes.getKSP())
 
-    def frozen_phase_line_search(self) -> Optional[str]:
-        """The line search of the frozen-surface phase of a ``"current"`` step,
-        when the user chose none: ``basic``, as for the initial and previous
-        configurations. That phase is the piecewise-linear "previous" model,
-        where ``l2`` (chosen for the current surface, see
-        :meth:`default_options`) only slowed the active set down: Hertz 3D
-        with two bodies, iterative linear solver, 33 against 13 Newton
-        iterations at 30k dofs and 31 against 11 at 52k. None: no switch."""
+    def library_line_search(self) -> bool:
+        """Whether the current-surface phase of a ``"current"`` step takes the
+        library's line search (:class:`~dolfinx_mortar.solver.line_search.FullStepFirst`):
+        a term uses the current configuration and the user set no
+        ``snes_linesearch_type``. The frozen phase keeps ``basic``: it is the
+        piecewise-linear "previous" model, where ``l2`` only slowed the active
+        set down (Hertz 3D with two bodies, iterative linear solver, 33 against
+        13 Newton iterations at 30k dofs and 31 against 11 at 52k)."""
         if not any(term.basis_configuration == "current" for term in self.contacts):
-            return None
+            return False
         key = "snes_linesearch_type"
-        if key in self.petsc_options or self._user_options.get(key, False):
-            return None
-        return "basic"
+        return not (key in self.petsc_options or self._user_options.get(key, False))
 
     def _configure_preconditioner(self, ksp: PETSc.KSP) -> None:
         """The contact-block preconditioner for ``pc_type python`` (the
@@ -297,12 +299,8 @@ class LoadPathSolver:
             if frozen:
                 for term in self.contacts:
                     stack.enter_context(term.frozen())
-            line_search = self.frozen_phase_line_search() if frozen else None
-            if line_search is not None:
-                with TemporaryOptions(self.prefix, {"snes_linesearch_type": line_search}):
-                    self._configure_from_options(snes)
-                # the current phase reads its own line search back
-                stack.callback(self._configure_from_options, snes)
+            if frozen and self.line_search is not None:
+                stack.enter_context(self.line_search.suspended())
             close_gaps(self.problem, snes.getKSP(), x)
             snes.setConvergenceHistory(reset=True)
             clock = time.perf_counter()

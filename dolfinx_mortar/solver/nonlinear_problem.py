@@ -22,6 +22,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.term import ContactTerm
@@ -76,11 +77,36 @@ class NonlinearContactProblem:
         self.attach_near_nullspace = False
         #: wall times of the bulk assembly, seconds (the contact's are in each term's timings)
         self.timings: dict[str, float] = {}
+        #: a residual evaluated ahead, for the next :meth:`F` (see :meth:`offer_residual`)
+        self._offered: Optional[tuple[np.ndarray, PETSc.Vec]] = None
 
     # -- what NewtonSolver and SNES call -----------------------------------------------
     def form(self, x: PETSc.Vec) -> None:
         """Bring x's ghosts up to date (DOLFINx's NewtonSolver calls this first)."""
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+    def offer_residual(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        """Offer the residual ``b`` just assembled at ``x`` to the next :meth:`F`.
+
+        That call copies it instead of assembling again if its point equals
+        ``x`` bit for bit on every rank; any other point, or any later call,
+        assembles as usual. For a line search that has evaluated its trial
+        point before the solver's own evaluation of the same point
+        (:class:`~dolfinx_mortar.solver.line_search.FullStepFirst`), with
+        nothing in between that could change the residual.
+        """
+        self._offered = (x.array_r.copy(), b.copy())
+
+    def _take_offer(self, x: PETSc.Vec, b: PETSc.Vec) -> bool:
+        """Copy the offered residual into ``b`` if it was made at ``x`` (collective)."""
+        offered, self._offered = self._offered, None
+        same = offered is not None and np.array_equal(offered[0], x.array_r)
+        same = x.getComm().tompi4py().allreduce(same, op=MPI.LAND)
+        if same:
+            offered[1].copy(b)
+        if offered is not None:
+            offered[1].destroy()
+        return same
 
     def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
         """Assemble the residual at ``x`` into ``b`` (the contact states are updated)."""
@@ -88,6 +114,9 @@ class NonlinearContactProblem:
         if x.handle != self.u.vector.handle:
             x.copy(self.u.vector)
         self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        if self._take_offer(x, b):
+            # the contact states are those of the offer's evaluation, at this x
+            return
         with b.localForm() as local:
             local.set(0.0)
         fem_petsc.assemble_vector(b, self.L)

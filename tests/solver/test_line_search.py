@@ -1,0 +1,218 @@
+"""The current-surface line search (full step first, else PETSc's l2 step
+length) and the residual it offers to the solver's next evaluation."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+from support import load_demo
+from support.meshes import rectangle
+
+from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidSphere
+from dolfinx_mortar.solver.line_search import FullStepFirst, l2_step_length
+
+BOTTOM, TOP, LEFT = 1, 2, 3
+
+
+@pytest.mark.parametrize("minimizer", [0.3, 0.9, 1.7])
+def test_l2_step_length_is_the_minimizer_of_a_parabola(minimizer):
+    """On an exact parabola l2's secant step lands on its minimizer."""
+    f = [(lam - minimizer) ** 2 + 0.1 for lam in (0.0, 0.5, 1.0)]
+    assert l2_step_length(*f) == pytest.approx(minimizer, rel=1e-14)
+
+
+def test_l2_step_length_keeps_petscs_safeguards():
+    # concave: "always downhill" from λ = 1, along the slope there
+    assert l2_step_length(1.0, 1.2, 1.0) == pytest.approx(1.5)
+    # a step below the minimum becomes 1/2; one that is not finite, 1
+    assert l2_step_length(1.0, 0.25, 1.0) == 0.5
+    assert l2_step_length(1.0, np.nan, np.nan) == 1.0
+
+
+class ArctanProblem:
+    """F(x) = arctan(x) per entry: Newton from |x| > 1.39 overshoots, so the
+    full step raises ‖F‖ there; near the root it converges quadratically.
+    The callbacks FullStepFirst uses, as NonlinearContactProblem has them."""
+
+    def __init__(self, n: int):
+        self._b = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
+        self.evaluations = 0
+        self.offers = 0
+
+    def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        self.evaluations += 1
+        b.array[:] = np.arctan(x.array_r)
+
+    def vector(self) -> PETSc.Vec:
+        return self._b
+
+    def offer_residual(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        self.offers += 1
+
+    def snes(self, line_search: str) -> PETSc.SNES:
+        snes = PETSc.SNES().create(PETSc.COMM_SELF)
+        n = self._b.getSize()
+        J = PETSc.Mat().createAIJ((n, n), nnz=1, comm=PETSc.COMM_SELF)
+
+        def jacobian(_snes, x, A, _P):
+            A.zeroEntries()
+            A.setDiagonal(PETSc.Vec().createWithArray(1 / (1 + x.array_r ** 2),
+                                                      comm=PETSc.COMM_SELF))
+            A.assemble()
+
+        snes.setFunction(lambda _snes, x, b: self.F(x, b), self._b)
+        snes.setJacobian(jacobian, J)
+        snes.setType("newtonls")
+        snes.getKSP().setType("preonly")
+        snes.getKSP().getPC().setType("lu")
+        opts = PETSc.Options()
+        opts["arctan_snes_linesearch_type"] = line_search
+        snes.setOptionsPrefix("arctan_")
+        snes.setFromOptions()
+        del opts["arctan_snes_linesearch_type"]
+        return snes
+
+
+def iterates(snes: PETSc.SNES, x0: np.ndarray, iterations: int) -> list[np.ndarray]:
+    out = []
+    x = PETSc.Vec().createWithArray(x0.copy(), comm=PETSc.COMM_SELF)
+    for _ in range(iterations):
+        snes.setTolerances(rtol=0.0, atol=0.0, stol=0.0, max_it=1)
+        snes.solve(None, x)
+        out.append(x.array_r.copy())
+    return out
+
+
+def test_cut_steps_are_petscs_l2_steps_and_other_steps_are_full():
+    """From x = (2, 0.1) the full Newton step raises ‖F‖: the step is PETSc's l2
+    step to round-off. From there the full step lowers ‖F‖ and is taken whole
+    (plain Newton), at one evaluation, with the trial residual offered."""
+    x0 = np.array([2.0, 0.1])
+    reference = ArctanProblem(2)
+    l2 = iterates(reference.snes("l2"), x0, 1)[0]
+
+    problem = ArctanProblem(2)
+    snes = problem.snes("basic")
+    line_search = FullStepFirst(problem, snes)
+    line_search.attach()
+    xs = iterates(snes, x0, 4)
+    assert np.allclose(xs[0], l2, rtol=1e-14, atol=1e-15)
+    assert line_search.cut_steps == 1
+    scale = np.max(np.abs(x0))
+    for before, after in zip(xs[:-1], xs[1:]):
+        newton = before - (1 + before ** 2) * np.arctan(before)
+        assert np.allclose(after, newton, rtol=1e-13, atol=1e-15 * scale)
+    assert line_search.full_steps == 3 == problem.offers
+    # arctan is odd: Newton converges cubically (e ← −2e³/3)
+    e = [np.max(np.abs(x)) / scale for x in xs[1:]]
+    assert e[2] < e[1] ** 2.5 and e[1] < e[0] ** 2.5, e
+
+
+def test_suspended_line_search_takes_full_steps_unchecked():
+    """The frozen phase: the pre-check stays attached but does nothing."""
+    problem = ArctanProblem(2)
+    snes = problem.snes("basic")
+    line_search = FullStepFirst(problem, snes)
+    line_search.attach()
+    x0 = np.array([2.0, 0.1])
+    with line_search.suspended():
+        x1 = iterates(snes, x0, 1)[0]
+    assert np.allclose(x1, x0 - (1 + x0 ** 2) * np.arctan(x0), rtol=1e-13)
+    assert line_search.full_steps == line_search.cut_steps == 0
+    assert line_search.active
+
+
+class CountingContactTerm(ContactTerm):
+    """A contact term that counts its evaluations."""
+
+    evaluations = 0
+
+    def update(self, bcs=()):
+        self.evaluations += 1
+        return super().update(bcs)
+
+
+def pressed_block(configuration: str = "current"):
+    """A neo-Hookean block pressed by its top face onto a rigid disk."""
+    domain, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (12, 6), bottom=BOTTOM, top=TOP,
+                             left=LEFT)
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    u = fem.Function(V)
+    F = load_demo("press_and_slide").neo_hookean_residual(u, 1.0, 0.3)
+    contact = CountingContactTerm(u, tags, BOTTOM, obstacle=RigidSphere([0.5, -2.0], 2.0),
+                                  kind="LcLS*", penalty=200.0,
+                                  basis_configuration=configuration)
+    push = fem.Constant(domain, PETSc.ScalarType(0.0))
+    left = fem.locate_dofs_topological(V.sub(0), 1, tags.find(LEFT))
+    top = fem.locate_dofs_topological(V.sub(1), 1, tags.find(TOP))
+    bcs = [fem.dirichletbc(PETSc.ScalarType(0.0), left, V.sub(0)),
+           fem.dirichletbc(push, top, V.sub(1))]
+    return NonlinearContactProblem(F, u, contact, bcs), contact, push
+
+
+def test_an_offered_residual_is_used_once_and_only_at_its_point():
+    problem, contact, push = pressed_block()
+    push.value = -0.01
+    u = problem.u
+    u.interpolate(lambda x: np.vstack([0.01 * x[1], -0.002 - 0.02 * x[1]]))
+    fem.petsc.set_bc(u.vector, problem.bcs)
+    x = u.vector.copy()
+    fresh, b = problem.vector().duplicate(), problem.vector().duplicate()
+    problem.F(x, fresh)
+    before = contact.evaluations
+
+    problem.offer_residual(x, fresh)
+    problem.F(x, b)                       # the offer: copied, no evaluation
+    assert contact.evaluations == before
+    assert np.array_equal(b.array_r, fresh.array_r)
+    problem.F(x, b)                       # an offer serves one call only
+    assert contact.evaluations == before + 1
+    assert np.array_equal(b.array_r, fresh.array_r)
+
+    y = x.copy()
+    y.array[:] += 1e-4 * np.random.default_rng(MPI.COMM_WORLD.rank).normal(size=y.array.shape)
+    fem.petsc.set_bc(y, problem.bcs)
+    at_y = problem.vector().duplicate()
+    problem.F(y, at_y)
+    problem.offer_residual(x, fresh)
+    problem.F(y, b)                       # not the offer's point: assembled
+    assert contact.evaluations == before + 3
+    assert np.array_equal(b.array_r, at_y.array_r)
+
+
+def test_current_surface_steps_cost_one_residual_when_taken_whole():
+    """One Newton solve on the current surface from the solution at a nearby
+    load, with the library's line search and with PETSc's l2: the same
+    solution to the Newton tolerance; l2 evaluates the residual three times
+    per iteration, the library's once per full step and three times per cut
+    one (and once at the start, as both do)."""
+    problem, contact, push = pressed_block()
+    start = LoadPathSolver(problem)
+    start.solve(lambda t: setattr(push, "value", -0.02 * t), load_steps=2)
+    x0 = problem.u.vector.copy()
+    push.value = -0.025
+    solutions, counts = [], []
+    for options in ({}, {"snes_linesearch_type": "l2"}):
+        solver = LoadPathSolver(problem, petsc_options=options)
+        with solver.options():
+            snes = solver.create_snes()
+            x = x0.copy()
+            before = contact.evaluations
+            snes.solve(None, x)
+            assert snes.getConvergedReason() > 0
+            counts.append((contact.evaluations - before, snes.getIterationNumber(),
+                           solver.line_search))
+            solutions.append(x.array_r.copy())
+            snes.destroy()
+    (ours, iterations, line_search), (theirs, l2_iterations, none) = counts
+    assert none is None
+    assert line_search.full_steps + line_search.cut_steps == iterations
+    assert line_search.full_steps >= 2
+    assert ours == 1 + line_search.full_steps + 3 * line_search.cut_steps
+    assert theirs == 1 + 3 * l2_iterations
+    comm = MPI.COMM_WORLD
+    norm = np.sqrt(comm.allreduce(np.sum(solutions[1] ** 2)))
+    difference = np.sqrt(comm.allreduce(np.sum((solutions[0] - solutions[1]) ** 2)))
+    assert difference < 1e-9 * norm
