@@ -18,8 +18,9 @@ from dolfinx_mortar.demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import write_csv
 
 COLUMNS = ("configuration", "dofs", "newton", "wall_time", "contact_time", "bulk_time",
-           "contact_per_newton", "bulk_per_newton", "contact_over_bulk", "p0_error",
-           "a_error")
+           "contact_per_newton", "bulk_per_newton", "contact_over_bulk",
+           "contact_residual_per_newton", "contact_jacobian_per_newton", "full_steps",
+           "cut_steps", "p0_error", "a_error")
 
 
 def main() -> None:
@@ -51,26 +52,39 @@ def main() -> None:
         bulk = comm.allreduce(t.get("bulk_residual", 0.0) + t.get("bulk_jacobian", 0.0),
                               op=MPI.MAX)
         newton = max(result.newton_iterations, 1)
+        parts = {key: comm.allreduce(t.get(f"contact_{key}", 0.0), op=MPI.MAX) / newton
+                 for key in ("residual", "jacobian")}
+        # the current-surface line search: steps taken in full and cut
+        line_search = problem.solver.line_search
         rows.append({"configuration": configuration, "dofs": figures["dofs"],
                      "newton": result.newton_iterations, "wall_time": wall,
                      "contact_time": contact, "bulk_time": bulk,
                      "contact_per_newton": contact / newton, "bulk_per_newton": bulk / newton,
-                     "contact_over_bulk": contact / bulk, "p0_error": figures["p0_error"],
+                     "contact_over_bulk": contact / bulk,
+                     "contact_residual_per_newton": parts["residual"],
+                     "contact_jacobian_per_newton": parts["jacobian"],
+                     "full_steps": line_search.full_steps if line_search else 0,
+                     "cut_steps": line_search.cut_steps if line_search else 0,
+                     "p0_error": figures["p0_error"],
                      "a_error": figures["a_error"]})
         if comm.rank == 0:
-            print(rows[-1], {k: round(v, 3) for k, v in t.items()}, flush=True)
+            print(rows[-1], flush=True)
     if comm.rank == 0:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         write_csv(args.out + ".csv", rows, COLUMNS)
         lines = [f"Hertz 3D, two bodies, refine {args.refine}, {args.load_steps} load step(s), "
                  f"{comm.size} rank(s), {args.partitioner} partition; load average {load:.2f} at the start", "",
-                 "| configuration | dofs | Newton | wall s | contact s / Newton | "
-                 "bulk assembly s / Newton | contact / bulk | p0 err | a err |",
-                 "|---|---|---|---|---|---|---|---|---|"]
+                 "| configuration | dofs | Newton | wall s | contact s / Newton (residuals + "
+                 "Jacobian) | bulk assembly s / Newton | contact / bulk | full / cut steps | "
+                 "p0 err | a err |",
+                 "|---|---|---|---|---|---|---|---|---|---|"]
         for r in rows:
             lines.append(f"| {r['configuration']} | {r['dofs']} | {r['newton']} | "
-                         f"{r['wall_time']:.1f} | {r['contact_per_newton']:.3f} | "
+                         f"{r['wall_time']:.1f} | {r['contact_per_newton']:.3f} "
+                         f"({r['contact_residual_per_newton']:.3f} + "
+                         f"{r['contact_jacobian_per_newton']:.3f}) | "
                          f"{r['bulk_per_newton']:.3f} | {r['contact_over_bulk']:.2f} | "
+                         f"{r['full_steps']} / {r['cut_steps']} | "
                          f"{100 * r['p0_error']:+.2f}% | {100 * r['a_error']:+.2f}% |")
         Path(args.out + ".md").write_text("\n".join(lines) + "\n")
         print("\n".join(lines))
