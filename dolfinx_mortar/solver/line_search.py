@@ -65,7 +65,9 @@ class FullStepFirst:
     Parameters
     ----------
     problem
-        The problem whose residual SNES evaluates.
+        The problem whose residual SNES evaluates: its ``F(x, b)``,
+        ``vector()`` and ``offer_residual(x, b)`` are used
+        (:class:`~dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem`).
     snes
         The SNES it is attached to (its residual norm at the current iterate).
 
@@ -105,6 +107,9 @@ class FullStepFirst:
         return residual.norm() ** 2
 
     def __call__(self, x: PETSc.Vec, y: PETSc.Vec) -> bool:
+        """The pre-check at the iterate ``x`` with the Newton direction ``y``
+        (the basic line search then takes ``x − y``); returns whether it
+        scaled ``y``."""
         if not self.active:
             return False
         f0 = self.snes.getFunctionNorm() ** 2
@@ -118,8 +123,6 @@ class FullStepFirst:
             f_mid = self._squared_norm_at(x, y, 0.5, point, residual)
             step = l2_step_length(f0, f_mid, f1)
             self.cut_steps += 1
-            if step == 1.0:
-                return False
             y.scale(step)
             return True
         finally:
