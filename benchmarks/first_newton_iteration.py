@@ -18,6 +18,7 @@ Appends a row to ``first_newton_iteration.{csv,md}`` in ``--out``
 from __future__ import annotations
 
 import argparse
+import csv
 import os
 import resource
 import time
@@ -26,7 +27,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from dolfinx_mortar.demo_support.scripts import load_demo
-from dolfinx_mortar.io.output import write_atomically
+from dolfinx_mortar.io.output import write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent
 COLUMNS = ("solver", "refine", "ranks", "dofs", "setup_s", "iteration_s", "linear_s",
@@ -82,17 +83,17 @@ def main() -> None:
            "reason": reason}
     if comm.rank == 0:
         out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        csv = out / "first_newton_iteration.csv"
-        lines = csv.read_text().splitlines() if csv.exists() else [",".join(COLUMNS)]
-        lines.append(",".join(str(row[c]) for c in COLUMNS))
-        text = "\n".join(lines) + "\n"
-        write_atomically(csv, lambda tmp: Path(tmp).write_text(text))
+        csv_path = out / "first_newton_iteration.csv"
+        rows = []
+        if csv_path.exists():
+            with open(csv_path, newline="") as f:
+                rows = list(csv.DictReader(f))
+        rows.append(row)
+        write_csv(csv_path, rows, COLUMNS)
         table = ["| solver | refine | ranks | dofs | setup s | iteration s | linear solve s | "
                  "Krylov | peak memory GB | load average | SNES/KSP reason |",
                  "|---|---|---|---|---|---|---|---|---|---|---|"]
-        for line in lines[1:]:
-            r = dict(zip(COLUMNS, line.split(",")))
+        for r in rows:
             table.append(f"| {r['solver']} | {float(r['refine']):g} | {r['ranks']} | {r['dofs']} | "
                          f"{float(r['setup_s']):.1f} | {float(r['iteration_s']):.1f} | "
                          f"{float(r['linear_s']):.1f} | {r['krylov']} | "
@@ -101,8 +102,7 @@ def main() -> None:
         markdown = "\n".join(table) + "\n"
         write_atomically(out / "first_newton_iteration.md",
                          lambda tmp: Path(tmp).write_text(markdown))
-        print("\n".join(table), flush=True)
-
+        print(markdown, flush=True)
 
 if __name__ == "__main__":
     main()

@@ -93,19 +93,21 @@ class NonlinearContactProblem:
         assembles as usual. For a line search that has evaluated its trial
         point before the solver's own evaluation of the same point
         (:class:`~dolfinx_mortar.solver.line_search.FullStepFirst`), with
-        nothing in between that could change the residual.
+        nothing in between that could change the residual. Collective: every
+        rank offers, or none.
         """
         self._offered = (x.array_r.copy(), b.copy())
 
     def _take_offer(self, x: PETSc.Vec, b: PETSc.Vec) -> bool:
         """Copy the offered residual into ``b`` if it was made at ``x`` (collective)."""
         offered, self._offered = self._offered, None
-        same = offered is not None and np.array_equal(offered[0], x.array_r)
-        same = x.getComm().tompi4py().allreduce(same, op=MPI.LAND)
+        if offered is None:        # on every rank: offers are collective
+            return False
+        point, residual = offered
+        same = x.getComm().tompi4py().allreduce(np.array_equal(point, x.array_r), op=MPI.LAND)
         if same:
-            offered[1].copy(b)
-        if offered is not None:
-            offered[1].destroy()
+            residual.copy(b)
+        residual.destroy()
         return same
 
     def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:

@@ -196,10 +196,11 @@ class FailsOnceAt(ContactProblem):
     is a NaN traction: Newton fails there whatever the machine's round-off."""
 
     fail_at = 5 / 6
+    failed_once = False
 
     def set_load(self, factor: float) -> None:
         super().set_load(factor)
-        if abs(factor - self.fail_at) <= 1e-12 and not getattr(self, "failed_once", False):
+        if abs(factor - self.fail_at) <= 1e-12 and not self.failed_once:
             self.failed_once = True
             self.load.value = np.nan
 
