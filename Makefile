@@ -1,20 +1,39 @@
 # dolfinx_mortar: setup, demo, test, bench. Run `make help` for the targets.
-# Everything runs with Debian's interpreter: the first python3 on PATH may be
-# another one that cannot import DOLFINx.
-PYTHON ?= /usr/bin/python3
+# Debian 13 (trixie: DOLFINx 0.9) or sid (DOLFINx 0.11). `make setup` installs the Debian
+# packages, then dolfinx_mortar (its Python files and the compiled kernels) into the virtual
+# environment .venv, which also sees Debian's packages (DOLFINx, PETSc, ...); every target below
+# runs with its interpreter. Another environment that has DOLFINx and pip: make PYTHON=...
+SYSTEM_PYTHON ?= /usr/bin/python3
+VENV ?= .venv
+PYTHON ?= $(VENV)/bin/python
+# after `cd /`: the same interpreter
+PYTHON_ABS = $(if $(findstring /,$(PYTHON)),$(abspath $(PYTHON)),$(PYTHON))
+# the C++ tests' build (the wheel's build is build/<wheel tag>, pyproject.toml)
 BUILD_DIR ?= build
+# A 2-core machine: compile with 2 jobs (CMake's, ninja's and scikit-build-core's builds).
+JOBS ?= 2
+export CMAKE_BUILD_PARALLEL_LEVEL := $(JOBS)
+# pip: only what is on this machine (Debian's packages), no PyPI; no question to PyPI either.
+PIP_INSTALL = $(PYTHON) -m pip install --no-index --no-build-isolation
+export PIP_DISABLE_PIP_VERSION_CHECK := 1
 # A failure on one rank can leave the other waiting in a collective: the
 # timeout turns such a hang into a failure instead of a stuck CI run.
 MPIRUN ?= timeout 1800 mpirun -n 2 --oversubscribe
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+# The two ranks talk through shared memory, no network transport is probed.
+export OMPI_MCA_btl := self,sm
 # Keep OpenMP/BLAS threads from fighting the MPI ranks on a 2-core machine.
 export OMP_NUM_THREADS := 1
+# pytest with the installed package: -P keeps the checkout (the current directory) off
+# sys.path, so that `import dolfinx_mortar` is the installed package, with its kernels.
+PYTEST = $(PYTHON) -P -m pytest -q --color=no
 
 DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 	python3-ffcx python3-petsc4py python3-mpi4py python3-gmsh pybind11-dev \
 	libeigen3-dev python3-pytest python3-matplotlib python3-scipy python3-tqdm \
-	python3-dev cmake g++ make libgtest-dev openmpi-bin libopenblas0-serial python3-h5py
+	python3-dev cmake g++ make libgtest-dev openmpi-bin libopenblas0-serial python3-h5py \
+	python3-scikit-build-core python3-pip python3-venv ninja-build
 # libopenblas0-serial replaces the reference BLAS behind PETSc/MUMPS: 3.7x faster
 # factorizations on Hertz 3D (33 s -> 8.8 s), serial so it does not fight MPI ranks.
 
@@ -24,20 +43,43 @@ DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 # cell measures 5.6e-17 with SkylakeX kernels and 0 with Haswell's).
 SECOND_CORETYPE ?= Haswell
 
-.PHONY: help setup deps build install demo test test-cpp test-python test-mpi test-coretype bench bench-speed bench-scale stress clean
+# make shell-SUITE: the Debian root $(DEBIAN_ROOTS)/$(DEV_ROOT)-SUITE (tools/debian-root)
+DEBIAN_ROOTS ?= $(or $(DOLFINX_MORTAR_ROOTS),/var/tmp/dolfinx_mortar-roots)
+DEV_ROOT ?= dev
+
+# The targets run one after the other even under make -j (the builds inside use $(JOBS) jobs).
+.NOTPARALLEL:
+
+.PHONY: help setup deps venv build-cpp demo test test-cpp test-python test-mpi test-coretype \
+	bench bench-speed bench-scale stress shell-trixie shell-sid clean
 
 help:
-	@echo "make setup  - install missing Debian packages, build the kernels, make dolfinx_mortar importable"
+	@echo "make setup  - install missing Debian packages, make the virtual environment .venv (it sees"
+	@echo "              Debian's DOLFINx) and install dolfinx_mortar into it: pip builds the kernels"
 	@echo "make demo   - setup, then the main demo (Hertz 2D, figures 1 and 2) into results/"
 	@echo "make test   - setup, then C++ tests (ctest), pytest, pytest under mpirun -n 2, and"
 	@echo "              pytest again with another CPU's BLAS kernels (OPENBLAS_CORETYPE)"
+	@echo "make test-cpp    - build the C++ kernels and their GoogleTest tests in build/, run ctest"
+	@echo "make test-python / test-mpi / test-coretype - one of the pytest runs of make test"
 	@echo "make bench  - setup, then the benchmarks in benchmarks/ (speed vs error: --quick)"
 	@echo "make bench-speed - setup, then the full speed-vs-error study (~25 min, serial)"
 	@echo "make bench-scale - setup, then Krylov iterations against h and penalty, and 1 against 2"
 	@echo "              ranks, on Hertz 3D with two bodies (~1.5 h; docs/SCALING.md)"
-	@echo "make stress - setup, then 1e6 generated slave-master pairs through 3D segmentation"
+	@echo "make stress - 1e6 generated slave-master pairs through 3D segmentation (C++)"
+	@echo "make shell-trixie, make shell-sid - as root, on another Debian release: a shell in a"
+	@echo "              Debian 13 (DOLFINx 0.9) or sid (DOLFINx 0.11) root, made if missing from a"
+	@echo "              debootstrap base (tools/debian-root; $(DEBIAN_ROOTS)/$(DEV_ROOT)-SUITE), with a"
+	@echo "              copy of this checkout in /root/dolfinx_mortar (copied again each time; its"
+	@echo "              build/ and .venv are kept). Run make setup, make test, ... there."
+	@echo "make clean  - remove build/, .venv and in-tree build remnants"
+	@echo "Python: $(PYTHON) (make PYTHON=... for another environment with DOLFINx)"
 
-setup: deps build install
+setup: deps venv
+	$(PIP_INSTALL) .
+	@cd / && $(PYTHON_ABS) -c "import dolfinx, dolfinx_mortar.kernels; \
+	from importlib.metadata import version; from pathlib import Path; \
+	print('dolfinx_mortar', version('dolfinx_mortar'), 'in', Path(dolfinx_mortar.__file__).parent, \
+	      'with DOLFINx', dolfinx.__version__)"
 
 deps:
 	@missing=""; for p in $(DEB_PACKAGES); do \
@@ -52,17 +94,19 @@ deps:
 	  apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q$$missing; \
 	fi
 
-build:
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(PYTHON) > /dev/null
-	cmake --build $(BUILD_DIR) -j2
+# The virtual environment: made again if its pip does not run (missing, or made by another
+# Python version). --system-site-packages: it sees Debian's DOLFINx, numpy, scipy, ...
+venv:
+	@if [ "$(PYTHON)" = "$(VENV)/bin/python" ] && ! $(PYTHON) -m pip --version >/dev/null 2>&1; then \
+	  echo "Making the virtual environment $(VENV)"; \
+	  rm -rf $(VENV) && $(SYSTEM_PYTHON) -m venv --system-site-packages $(VENV); \
+	fi
 
-# An editable install without pip: a .pth file that puts this checkout on
-# Debian's interpreter's path (what `pip install -e` would do, minus the
-# network and build isolation).
-install:
-	@site=$$($(PYTHON) -c "import site; print(site.getsitepackages()[0])"); \
-	mkdir -p $$site && echo "$(CURDIR)" > $$site/dolfinx_mortar.pth; \
-	cd / && $(PYTHON) -c "import dolfinx_mortar, sys; print('dolfinx_mortar importable from', dolfinx_mortar.__file__)"
+# The kernels with their GoogleTest tests, in build/ (not the wheel's build).
+build-cpp:
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=ON \
+		-DPython_EXECUTABLE=$(SYSTEM_PYTHON)
+	cmake --build $(BUILD_DIR) -j$(JOBS)
 
 demo: setup
 	$(PYTHON) demos/hertz2d.py --json results/hertz2d.json --output results/hertz2d.xdmf
@@ -71,17 +115,17 @@ demo: setup
 
 test: setup test-cpp test-python test-mpi test-coretype
 
-test-cpp:
+test-cpp: build-cpp
 	cd $(BUILD_DIR) && ctest --output-on-failure
 
 test-python:
-	$(PYTHON) -m pytest -q --color=no tests
+	$(PYTEST) tests
 
 test-mpi:
-	$(MPIRUN) $(PYTHON) -m pytest -q --color=no -p no:cacheprovider tests
+	$(MPIRUN) $(PYTEST) -p no:cacheprovider tests
 
 test-coretype:
-	OPENBLAS_CORETYPE=$(SECOND_CORETYPE) $(PYTHON) -m pytest -q --color=no -p no:cacheprovider tests
+	OPENBLAS_CORETYPE=$(SECOND_CORETYPE) $(PYTEST) -p no:cacheprovider tests
 
 bench: setup
 	$(PYTHON) benchmarks/bench_basis_construction.py
@@ -99,8 +143,29 @@ bench-scale: setup
 	$(MPIRUN) $(PYTHON) benchmarks/krylov_scaling.py --levels 2 --penalties 1e3 \
 		--solvers block direct --tag n2
 
-stress: setup
+stress: deps build-cpp
 	$(BUILD_DIR)/kernels/stress_segmentation 1000000 1
 
+# A shell in a Debian root of another release (as root): the root is made once from the
+# suite's debootstrap base and kept (its packages, .venv and build/ too); the checkout is
+# copied in anew each time, without .git, build/, .venv and results/.
+shell-trixie shell-sid: shell-%:
+	@root=$(DEBIAN_ROOTS)/$(DEV_ROOT)-$*; \
+	if [ -x "$$root/usr/bin/apt-get" ]; then \
+	  DOLFINX_MORTAR_ROOTS=$(DEBIAN_ROOTS) tools/debian-root mount "$$root" > /dev/null; \
+	else \
+	  echo "Making the Debian root $$root (tools/debian-root fresh $* $(DEV_ROOT)-$*)"; \
+	  DOLFINX_MORTAR_ROOTS=$(DEBIAN_ROOTS) tools/debian-root fresh $* $(DEV_ROOT)-$* > /dev/null; \
+	fi && \
+	dest="$$root/root/dolfinx_mortar" && mkdir -p "$$dest" && \
+	find "$$dest" -mindepth 1 -maxdepth 1 ! -name build ! -name .venv ! -name results \
+	  -exec rm -rf {} + && \
+	tar -C "$(CURDIR)" --exclude=./.git --exclude=./build --exclude=./.venv --exclude=./results \
+	  -cf - . | tar -C "$$dest" -xf - && \
+	echo "$*: /root/dolfinx_mortar is a copy of $(CURDIR) (edits here are not copied back)." && \
+	echo "$*: make setup (the first time: the Debian packages), make test, ...; exit to leave." && \
+	DOLFINX_MORTAR_ROOTS=$(DEBIAN_ROOTS) tools/debian-root run "$$root" \
+	  'export debian_chroot=$(DEV_ROOT)-$*; cd /root/dolfinx_mortar && exec bash -i'
+
 clean:
-	rm -rf $(BUILD_DIR) dolfinx_mortar/_kernels*.so
+	rm -rf $(BUILD_DIR) build $(VENV) _skbuild dolfinx_mortar/_kernels*.so *.egg-info dolfinx_mortar.egg-info

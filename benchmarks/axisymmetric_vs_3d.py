@@ -6,7 +6,7 @@ one process and tabulates the errors of the peak pressure p0 and of the contact
 radius a against Hertz, the L2 error of the pressure, the dofs and the wall
 time, so that the two can be compared at equal accuracy or equal time.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/axisymmetric_vs_3d.py [--out DIR]
+    OMP_NUM_THREADS=1 python3 benchmarks/axisymmetric_vs_3d.py [--out DIR]
 
 Writes ``axisymmetric_vs_3d.{csv,md,png}`` into ``--out`` (default
 ``benchmarks/results/``).
@@ -21,7 +21,7 @@ from typing import Optional, Sequence
 
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.scripts import load_demo
+from demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import save_figure, write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent

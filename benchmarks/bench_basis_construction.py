@@ -20,7 +20,7 @@ all sizes per surface and kind, and writes a CSV and a PNG.
 
 Run with Debian's interpreter, single process::
 
-    /usr/bin/python3 benchmarks/bench_basis_construction.py --help
+    python3 benchmarks/bench_basis_construction.py --help
 """
 from __future__ import annotations
 

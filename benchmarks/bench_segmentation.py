@@ -5,7 +5,7 @@ fine per direction, so ~0.6× the facets) for 2D lines and 3D triangles and
 quadrilaterals of degree 1 and 2, from 1e3 to 1e5 slave facets. The segmentation
 kernel is single-threaded, so its rate is a rate per core.
 
-    /usr/bin/python3 benchmarks/bench_segmentation.py [--max-facets 1e5]
+    python3 benchmarks/bench_segmentation.py [--max-facets 1e5]
 """
 from __future__ import annotations
 

@@ -10,8 +10,8 @@ evaluations and the Jacobian assembly, next to its bulk assembly. A rank that
 holds the contact zone alone shows here as the one whose contact time does
 not fall with the rank count.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/contact_parallel.py --refine 2
-    mpirun -n 2 /usr/bin/python3 benchmarks/contact_parallel.py --refine 2 [--profile]
+    OMP_NUM_THREADS=1 python3 benchmarks/contact_parallel.py --refine 2
+    mpirun -n 2 python3 benchmarks/contact_parallel.py --refine 2 [--profile]
 
 ``--partitioner graph`` uses DOLFINx's graph partition alone, as before the
 contact-balanced partitioner (the default).
@@ -35,7 +35,7 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.scripts import load_demo
+from demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import write_csv
 
 HERE = Path(__file__).resolve().parent

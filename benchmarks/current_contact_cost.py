@@ -3,7 +3,7 @@ with two elastic bodies: ``basis_configuration="current"`` (segmentation, exact
 gradients and Hessians from ``current_pair_gaps``, contact assembly) and, for
 comparison on the same mesh, ``"initial"``.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/current_contact_cost.py --refine 1.5
+    OMP_NUM_THREADS=1 python3 benchmarks/current_contact_cost.py --refine 1.5
 """
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.scripts import load_demo
+from demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import write_csv
 
 COLUMNS = ("configuration", "dofs", "newton", "wall_time", "contact_time", "bulk_time",

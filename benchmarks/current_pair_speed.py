@@ -2,13 +2,13 @@
 the double instantiation of the pair segmentation), values + gradients and
 values + gradients + Hessians (``current_pair_gaps``, the Jet instantiations; also the one
 node-weighted Hessian per pair that a Newton matrix asks for),
-per facet type, on the wavy patches of :mod:`dolfinx_mortar.demo_support.pair_scenes`.
+per facet type, on the wavy patches of :mod:`demo_support.pair_scenes`.
 
 ``--before COMMIT`` also times the Python Jets that the kernels replaced (3D P1
 triangles, ``pair_gap_3d`` of ``dolfinx_mortar/contact/current_mortar_3d.py`` at
 that commit, e.g. 3558d26) on the same pairs.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/current_pair_speed.py --before 3558d26
+    OMP_NUM_THREADS=1 python3 benchmarks/current_pair_speed.py --before 3558d26
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dolfinx_mortar.demo_support.pair_scenes import PairScene
+from demo_support.pair_scenes import PairScene
 from dolfinx_mortar.io.output import write_csv
 
 KINDS = ("P1_line", "P2_line", "P1_triangle", "Q1_quadrilateral")

@@ -9,7 +9,7 @@ the iterative path's; a whole solve is that times its Newton iterations.
 The iteration is the first of the first load step, from u = 0 (the gap-closing
 start of the load-path solver is not applied).
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/first_newton_iteration.py --refine 5 \\
+    OMP_NUM_THREADS=1 python3 benchmarks/first_newton_iteration.py --refine 5 \\
         --solver direct
 
 Appends a row to ``first_newton_iteration.{csv,md}`` in ``--out``
@@ -26,7 +26,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.scripts import load_demo
+from demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent
@@ -58,7 +58,7 @@ def main() -> None:
     with solver.options():
         snes = solver.create_snes()
         snes.setTolerances(max_it=1)
-        x = problem.u.vector.copy()
+        x = problem.u.x.petsc_vec.copy()
         comm.Barrier()
         clock = time.perf_counter()
         snes.solve(None, x)

@@ -17,8 +17,9 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.demo_support.hertz_fit import fit_hertz_profile
-from dolfinx_mortar.demo_support.scripts import load_demo
+from demo_support.hertz_fit import fit_hertz_profile
+from dolfinx_mortar.dolfinx_compat import create_mesh, geometry_dofmap
+from demo_support.scripts import load_demo
 
 ALL_KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")
 DUAL_KINDS = ("LcLS*", "LcLS")
@@ -74,13 +75,13 @@ def gmsh_mesh(comm: MPI.Comm, dim: int, build):
     """A DOLFINx mesh and facet tags from a gmsh model that ``build()`` makes on
     rank 0 (geometry, physical groups, sizes); meshed in ``dim`` dimensions."""
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     gmsh.initialize(["", "-v", "0"])
     try:
         if comm.rank == 0:
             build()
             gmsh.model.mesh.generate(dim)
-        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=dim)
+        domain, _, tags = model_to_mesh(gmsh.model, comm, 0, gdim=dim)
     finally:
         gmsh.finalize()
     return domain, tags
@@ -92,11 +93,11 @@ def newton_matrix(problem):
 
     For the local kinds this is the assembled Jacobian; for GLS/GLS* the
     Schur complement ``K + Ĝᵀ L⁻¹ diag(ωH) L⁻¹ Ĝ`` of the augmented system
-    (DESIGN.md §3), formed here only to measure it (dense only on the slave
+    (docs/DESIGN.md, §Augmented step), formed here only to measure it (dense only on the slave
     dofs).
     """
     import scipy.sparse
-    u = problem.u.vector
+    u = problem.u.x.petsc_vec
     J = problem.problem.matrix()
     problem.problem.F(u, problem.problem.vector())
     problem.problem.J(u, J)
@@ -206,8 +207,8 @@ def sweep(kinds=ALL_KINDS, nx: int = 8, offsets=SWEEP_OFFSETS, penalty: float = 
     h = 1.0 / nx
     lower = mesh.create_rectangle(comm, [[0, -0.5], [1, 0]], [nx, 4])
     upper = mesh.create_rectangle(comm, [[0, 0], [1, 0.5]], [5, 2])
-    Vs = fem.VectorFunctionSpace(lower, ("Lagrange", 1))
-    Vm = fem.VectorFunctionSpace(upper, ("Lagrange", 1))
+    Vs = fem.functionspace(lower, ("Lagrange", 1, (lower.geometry.dim,)))
+    Vm = fem.functionspace(upper, ("Lagrange", 1, (upper.geometry.dim,)))
     slave = facet_surface(Vs, facet_tags_from(lower, [(1, lambda x: np.isclose(x[1], 0))]), 1)
     master = facet_surface(Vm, facet_tags_from(upper, [(1, lambda x: np.isclose(x[1], 0))]), 1)
     K = _elastic_stiffness(Vs, E, nu)
@@ -312,7 +313,7 @@ def hertz2d_problem(kind: str, penalty_factor: float, refine: float = 0.3,
     args = demo.parse_args(["--refine", str(refine), "--obstacle", obstacle])
     ref = demo.hertz(args)
     domain, tags, h = demo.build_mesh(args, ref["a"], MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     fixed = {demo.SYMMETRY: {0: 0.0}}
     kwargs = {"obstacle": RigidPlane([0, 0], [0, 1])}
     if obstacle == "elastic":
@@ -401,7 +402,7 @@ def grazing(kind: str, force: float = 0.01, shear: float = 0.1, h_contact: float
     from dolfinx_mortar import ContactDivergenceError, ContactProblem
     R, E, nu = 1.0, 1.0, 0.3
     domain, tags = disk_with_neck_mesh(R, h_contact, MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0.0, 0.0], [0.0, 1.0]), E=E,
                              nu=nu, kind=kind, penalty=1e3 * E / h_contact,
                              fixed={2: {0: 0.0}},
@@ -444,6 +445,7 @@ def stacked_boxes(cell: str, n: int, mirror_upper: bool, comm: MPI.Comm,
     up to ``noise`` times the element size, as two separately meshed conforming
     faces differ by round-off. The motion is in-plane: a normal one would be a
     real gap, which the penalty turns into a pressure change ε·δ."""
+    import basix.ufl
     import ufl
     from dolfinx import mesh
     cell_type = {"tetrahedron": mesh.CellType.tetrahedron,
@@ -459,7 +461,7 @@ def stacked_boxes(cell: str, n: int, mirror_upper: bool, comm: MPI.Comm,
             on = x[:, 2] == 0.0
             rng = np.random.default_rng(seed)
             x[on, :2] += noise / n * rng.uniform(-1.0, 1.0, (int(on.sum()), 2))
-        cells = block.geometry.dofmap.array.reshape(block.topology.index_map(3).size_local, -1)
+        cells = geometry_dofmap(block)[:block.topology.index_map(3).size_local]
         if mirror and cell == "tetrahedron":
             cells = cells[:, [1, 0, 2, 3]]   # keep a positive orientation
         if mirror and cell == "hexahedron":
@@ -471,8 +473,8 @@ def stacked_boxes(cell: str, n: int, mirror_upper: bool, comm: MPI.Comm,
     else:
         x = np.zeros((0, 3))
         cells = np.zeros((0, parts[0][1].shape[1]), dtype=np.int64)
-    element = ufl.VectorElement("Lagrange", cell, 1)
-    domain = mesh.create_mesh(comm, cells, x, ufl.Mesh(element))
+    element = basix.ufl.element("Lagrange", cell, 1, shape=(3,))
+    domain = create_mesh(comm, cells, x, ufl.Mesh(element))
     # the interface facets: their (single) cell tells the body
     fdim = 2
     domain.topology.create_connectivity(fdim, 3)
@@ -503,7 +505,7 @@ def coincident_patch(kind: str, cell: str = "tetrahedron", mirror_upper: bool = 
     from dolfinx_mortar import ContactProblem
     comm = MPI.COMM_WORLD
     domain, tags = stacked_boxes(cell, n, mirror_upper, comm, noise=noise)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     h = 1.0 / n
     problem = ContactProblem(V, tags, LOWER_TOP, master_tag=UPPER_BOTTOM, E=1.0, nu=0.3,
                              kind=kind, penalty=1e3 / h,
@@ -583,7 +585,7 @@ def two_cylinders(kind: str, R1: float = 1.0, R2: float = 2.0, force: float = 0.
     p0 = 2 * force / (np.pi * a)
     h = a / (40 * refine)
     domain, tags = two_cylinders_mesh(R1, R2, h, a, MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, 1, master_tag=2, E=E, nu=nu, kind=kind,
                              penalty=1e3 * E / h, fixed={3: {0: 0.0}, 5: {1: 0.0}},
                              tractions={4: [0.0, -force / (2 * R1)]})
@@ -665,7 +667,7 @@ def two_spheres(kind: str, R1: float = 1.0, R2: float = 1.0, force: float = 0.00
     p0 = 3 * force / (2 * np.pi * a ** 2)
     h = a / (8 * refine)
     domain, tags = two_spheres_mesh(R1, R2, h, a, MPI.COMM_WORLD, cap=cap * a)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, 1, master_tag=2, E=E, nu=nu, kind=kind,
                              penalty=1e3 * E / h,
                              fixed={3: {0: 0.0}, 4: {1: 0.0}, 6: {2: 0.0}},
@@ -767,7 +769,7 @@ def elastic_sweep(kind: str, modification: bool, slivers=SLIVERS, dim: int = 2) 
     for sliver in slivers:
         build, h = (sliver_blocks, 0.1) if dim == 2 else (sliver_boxes, 0.2)
         domain, tags = build(sliver, MPI.COMM_WORLD)
-        V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+        V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
         down = {k: 0.0 for k in range(dim - 1)}
         problem = ContactProblem(V, tags, 1, master_tag=2, E=1.0, nu=0.3, kind=kind,
                                  penalty=1e3 / h, boundary_modification=modification,
@@ -856,7 +858,7 @@ def spurious_gap(kind: str, refine: float = 0.15) -> dict:
     a = 0.124
     h = a / (40 * refine)
     domain, tags = two_cylinders_mesh(1.0, 2.0, h, a, MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, 1, master_tag=2, E=1.0, nu=0.3, kind=kind,
                              penalty=1e3 / h, fixed={3: {0: 0.0}, 5: {1: 0.0}},
                              tractions={4: [0.0, -0.005]})

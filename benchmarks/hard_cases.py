@@ -4,7 +4,7 @@ Runs the scenes of hard_case_scenes.py, checks each against its pass
 criterion (the same as tests/contact/test_hard_cases.py), prints a table and writes
 results/hard_cases.csv (metric, value, criterion, verdict per row).
 
-    /usr/bin/python3 benchmarks/hard_cases.py [--skip-slow] [--cases sweep penalty ...]
+    python3 benchmarks/hard_cases.py [--skip-slow] [--cases sweep penalty ...]
 """
 from __future__ import annotations
 

@@ -22,9 +22,9 @@ Linear solvers (``--solvers``):
 - ``direct-reuse``: GMRES preconditioned by the MUMPS factorization of the
   first Newton matrix of each SNES solve (``snes_lag_preconditioner``).
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/krylov_scaling.py \\
+    OMP_NUM_THREADS=1 python3 benchmarks/krylov_scaling.py \\
         [--levels 0.5 1 2] [--penalties 1e1 1e2 1e3 1e4] [--solvers block direct] [--out DIR]
-    mpirun -n 2 /usr/bin/python3 benchmarks/krylov_scaling.py --levels 3 --penalties 1e3 \\
+    mpirun -n 2 python3 benchmarks/krylov_scaling.py --levels 3 --penalties 1e3 \\
         --tag n2            # the same under MPI
 
 Writes ``krylov_scaling[_TAG].{csv,md}`` into ``--out`` (default
@@ -43,7 +43,7 @@ from typing import Optional, Sequence
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.demo_support.scripts import load_demo
+from demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent

@@ -9,7 +9,7 @@ Newton iterations and the wall time. A combination the library refuses
 (``NotImplementedError``: the GLS kinds on the current surface) or that
 diverges (``ContactDivergenceError``) is a row with its reason, not a gap.
 
-    OMP_NUM_THREADS=1 /usr/bin/python3 benchmarks/press_and_slide_table.py
+    OMP_NUM_THREADS=1 python3 benchmarks/press_and_slide_table.py
     ... --refine 1 --out /tmp/slide    # the demo's default mesh, ~18 runs × 20 s
 
 Writes ``press_and_slide_table.csv`` and ``press_and_slide_table.md`` into
@@ -27,7 +27,7 @@ from typing import Optional, Sequence
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactDivergenceError
-from dolfinx_mortar.demo_support.scripts import load_demo
+from demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent

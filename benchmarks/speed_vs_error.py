@@ -27,8 +27,8 @@ and how far the result is from Hertz:
 the method costs once the mesh exists. ``wall_s`` also includes meshing (gmsh)
 and form compilation.
 
-    /usr/bin/python3 benchmarks/speed_vs_error.py            # full run (~25 min on a shared 2-core machine)
-    /usr/bin/python3 benchmarks/speed_vs_error.py --quick    # ~3–5 min
+    python3 benchmarks/speed_vs_error.py            # full run (~25 min on a shared 2-core machine)
+    python3 benchmarks/speed_vs_error.py --quick    # ~3–5 min
 """
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from dolfinx_mortar.demo_support.scripts import load_demo
+from demo_support.scripts import load_demo
 from dolfinx_mortar.io.output import save_figure, write_atomically, write_csv  # noqa: E402
 
 KINDS = ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS")

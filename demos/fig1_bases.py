@@ -3,7 +3,7 @@
 One panel per kind (GLS, GLS*, LmLS, LmLS*, LcLS*, LcLS), each showing every
 M_A over the parameter interval, as in Figure 1 of Duong, De Lorenzis and Sauer.
 
-    /usr/bin/python3 demos/fig1_bases.py --elements 5 --degree 2 --json results/fig1_bases.json
+    python3 demos/fig1_bases.py --elements 5 --degree 2 --json results/fig1_bases.json
 """
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 
 No contact is enforced: the sphere (radius R, centre above the middle of the
 unit square) sinks a depth δ into the plane z = 0, and the raw penalty pressure
-p = ε⟨d⟩ with d = R - |x - c| (minus the exact signed distance, DESIGN.md §3)
+p = ε⟨d⟩ with d = R - |x - c| (minus the exact signed distance; docs/DESIGN.md, §Penalty contact)
 is fitted by every mortar basis kind:
 
 - nodal pressures ``p_A = ∫ M̄_A p dA`` with ``M̄`` the unstarred partner
@@ -14,7 +14,7 @@ For a partition-of-unity kind ``p*`` approximates ``p``. For a non-PU kind
 ``M_A = M*_A / W_A`` is a density per unit area, so ``p*`` is of order ``p/W_A``:
 higher than its PU partner's, and growing as the mesh is refined.
 
-    /usr/bin/python3 demos/fig2_sphere_nurbs.py --elements 8 --levels 3 --json results/fig2_pressures.json
+    python3 demos/fig2_sphere_nurbs.py --elements 8 --levels 3 --json results/fig2_pressures.json
 """
 from __future__ import annotations
 

@@ -11,7 +11,7 @@ a the Hertz half-width and n_c = 40·refine.
 Hertz (plane strain): E* = E/(1−ν²) (rigid plane) or E/(2(1−ν²)) (two equal
 bodies), a = sqrt(4FR/(πE*)), p0 = 2F/(πa), p(x) = p0 sqrt(1 − x²/a²).
 
-    /usr/bin/python3 demos/hertz2d.py --json results/hertz2d.json
+    python3 demos/hertz2d.py --json results/hertz2d.json
 """
 from __future__ import annotations
 
@@ -22,11 +22,11 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
+from demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
                                 solver_demo_parser)
-from dolfinx_mortar.demo_support.hertz_meshes import (FIXED, LOAD, MASTER, SLAVE, SYMMETRY,
+from demo_support.hertz_meshes import (FIXED, LOAD, MASTER, SLAVE, SYMMETRY,
                                                       quarter_disk_mesh)
-from dolfinx_mortar.demo_support.hertz_fit import fit_hertz_profile
+from demo_support.hertz_fit import fit_hertz_profile
 from dolfinx_mortar.io.output import write_json
 
 
@@ -69,7 +69,7 @@ def build_mesh(args, a: float, comm: MPI.Comm):
 
 def contact_results(problem, ref: dict) -> dict:
     """Peak pressure and half-width (the Hertz profile fitted to the nodal
-    pressures, :func:`~dolfinx_mortar.demo_support.hertz_fit.fit_hertz_profile`)
+    pressures, :func:`~demo_support.hertz_fit.fit_hertz_profile`)
     and the L2 error."""
     comm = problem.mesh.comm
     slave = problem.slave
@@ -113,7 +113,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
     from dolfinx_mortar import ContactProblem
     ref = hertz(args)
     domain, facet_tags, h_contact = build_mesh(args, ref["a"], comm)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", args.degree))
+    V = fem.functionspace(domain, ("Lagrange", args.degree, (domain.geometry.dim,)))
     fixed = {SYMMETRY: {0: 0.0}}
     kwargs = {}
     if args.obstacle == "rigid":

@@ -19,7 +19,7 @@ Hertz: E* = E/(1−ν²) (rigid plane) or E/(2(1−ν²)) (two equal bodies),
 a = (3FR/(4E*))^⅓, p0 = 3F/(2πa²). With ``--load-displacement`` the force is
 the computed contact force.
 
-    /usr/bin/python3 demos/hertz3d.py --json results/hertz3d.json
+    python3 demos/hertz3d.py --json results/hertz3d.json
 """
 from __future__ import annotations
 
@@ -30,9 +30,9 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
+from demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
                                 solver_demo_parser)
-from dolfinx_mortar.demo_support.hertz_fit import fit_hertz_profile
+from demo_support.hertz_fit import fit_hertz_profile
 from dolfinx_mortar.io.output import write_json
 
 NAMES = ("slave", "master", "fixed", "load", "sym_x", "sym_y")
@@ -148,7 +148,7 @@ def read_mesh(path: str, comm: MPI.Comm):
 
 def contact_results(problem, E_star: float, R: float, force: float) -> dict:
     """Peak pressure and radius (the Hertz profile fitted to the nodal
-    pressures, :func:`~dolfinx_mortar.demo_support.hertz_fit.fit_hertz_profile`)
+    pressures, :func:`~demo_support.hertz_fit.fit_hertz_profile`)
     and the L2 error."""
     comm = problem.mesh.comm
     slave = problem.slave
@@ -195,7 +195,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
     else:
         domain, facet_tags, names = read_mesh(args.mesh, comm)
         h_contact = args.h_contact
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     if h_contact is None:
         from dolfinx_mortar.surfaces.facet_surface import facet_surface
         s = facet_surface(V, facet_tags, names["slave"])

@@ -15,7 +15,7 @@ Hertz: E* = E/(1−ν²) (rigid plane) or E/(2(1−ν²)) (two equal bodies), th
 effective radius R (plane, block) or R/2 (two spheres), a = (3FR_eff/(4E*))^⅓,
 p0 = 3F/(2πa²), p(r) = p0 √(1 − r²/a²).
 
-    /usr/bin/python3 demos/hertz_axisymmetric.py --json results/hertz_axisymmetric.json
+    python3 demos/hertz_axisymmetric.py --json results/hertz_axisymmetric.json
 """
 from __future__ import annotations
 
@@ -26,11 +26,11 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
+from demo_support.cli import (add_contact_options, parse_args_and_petsc_options,
                                              solver_demo_parser)
-from dolfinx_mortar.demo_support.hertz_meshes import (FIXED, LOAD, MASTER, SLAVE, SYMMETRY,
+from demo_support.hertz_meshes import (FIXED, LOAD, MASTER, SLAVE, SYMMETRY,
                                                       quarter_disk_mesh)
-from dolfinx_mortar.demo_support.hertz_fit import fit_hertz_profile
+from demo_support.hertz_fit import fit_hertz_profile
 from dolfinx_mortar.io.output import write_json
 
 LOWER_BODY = {"rigid": "none", "elastic": "block", "sphere": "disk"}
@@ -72,7 +72,7 @@ def hertz(args) -> dict:
 
 def contact_results(problem, ref: dict, radius: float) -> dict:
     """Peak pressure and contact radius (the Hertz profile fitted to the nodal
-    pressures, :func:`~dolfinx_mortar.demo_support.hertz_fit.fit_hertz_profile`)
+    pressures, :func:`~demo_support.hertz_fit.fit_hertz_profile`)
     and the L2 error of the pressure over the swept contact zone."""
     comm = problem.mesh.comm
     slave = problem.slave
@@ -109,7 +109,7 @@ def build_problem(args: argparse.Namespace, comm: MPI.Comm):
     h_contact = ref["a"] / (40 * args.refine)
     domain, facet_tags = quarter_disk_mesh(args.radius, ref["a"], h_contact,
                                            LOWER_BODY[args.obstacle], args.degree, comm)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", args.degree))
+    V = fem.functionspace(domain, ("Lagrange", args.degree, (domain.geometry.dim,)))
     fixed = {SYMMETRY: {0: 0.0}}     # u_r = 0 on the axis
     kwargs: dict = {}
     if args.obstacle == "rigid":

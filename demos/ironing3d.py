@@ -1,9 +1,9 @@
 """Ironing in 3D after Puso & Laursen (2004): a stiff half-cylindrical die pressed into a
 neo-Hookean slab and slid along it, frictionless, on the current configuration.
 
-The scene, its outputs and the figures: :mod:`dolfinx_mortar.demo_support.ironing`.
+The scene, its outputs and the figures: :mod:`demo_support.ironing`.
 
-    /usr/bin/python3 demos/ironing3d.py --csv results/ironing3d.csv \
+    python3 demos/ironing3d.py --csv results/ironing3d.csv \
         --png results/ironing3d.png --output results/ironing3d.xdmf
 """
 from __future__ import annotations
@@ -12,7 +12,7 @@ from typing import Optional, Sequence
 
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.ironing import parse_args, run
+from demo_support.ironing import parse_args, run
 
 
 def main(argv: Optional[Sequence[str]] = None) -> dict:

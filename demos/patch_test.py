@@ -7,7 +7,7 @@ planes x = 0 (and y = 0 in 3D) carry u_x = 0 (u_y = 0), the bottom u_z = 0 (u_y
 in 2D). The exact solution is a uniform stress σ = −p; a mortar method passes
 the test when every contact node carries exactly p.
 
-    /usr/bin/python3 demos/patch_test.py --dim 2 --json results/patch_test_2d.json
+    python3 demos/patch_test.py --dim 2 --json results/patch_test_2d.json
 """
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from typing import Optional, Sequence
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
+from demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
 from dolfinx_mortar.io.output import write_json
 
 LOWER_TOP, UPPER_BOTTOM, TOP, BOTTOM, SYM_X, SYM_Y = 1, 2, 3, 4, 5, 6
@@ -48,7 +48,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
 
 def build_mesh(dim: int, h_lower: float, h_upper: float, degree: int, comm: MPI.Comm):
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     gmsh.initialize(["", "-v", "0"])
     try:
         if comm.rank == 0:
@@ -85,7 +85,7 @@ def build_mesh(dim: int, h_lower: float, h_upper: float, degree: int, comm: MPI.
             gmsh.model.mesh.generate(dim)
             if degree == 2:
                 gmsh.model.mesh.setOrder(2)
-        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=dim)
+        domain, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=dim)
     finally:
         gmsh.finalize()
     return domain, facet_tags
@@ -98,7 +98,7 @@ def run(args, orientation: str, kind: str, scaling: str, comm=MPI.COMM_WORLD) ->
     # the slave is the lower block's top
     h_lower, h_upper = (fine, coarse) if orientation == "finer-slave" else (coarse, fine)
     domain, facet_tags = build_mesh(args.dim, h_lower, h_upper, args.degree, comm)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", args.degree))
+    V = fem.functionspace(domain, ("Lagrange", args.degree, (domain.geometry.dim,)))
     d = args.dim
     fixed = {SYM_X: {0: 0.0}, BOTTOM: {d - 1: 0.0}}
     if d == 3:

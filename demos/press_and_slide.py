@@ -15,7 +15,7 @@ on a uniform layer, and the track is symmetric about the block's centre.
 What is left is the discretization's ripple as slave nodes pass under the
 cylinder: the oscillation figures are its size relative to the normal force.
 
-    /usr/bin/python3 demos/press_and_slide.py --csv results/slide.csv --png results/slide.png
+    python3 demos/press_and_slide.py --csv results/slide.csv --png results/slide.png
 """
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar import (ContactDivergenceError, ContactTerm, LoadPathSolver,
                             NonlinearContactProblem, RigidSphere)
-from dolfinx_mortar.demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
+from demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
 from dolfinx_mortar.io.output import save_figure, write_csv, write_json
 
 TOP, BOTTOM = 1, 2
@@ -105,7 +105,7 @@ def build_mesh(args: argparse.Namespace, comm: MPI.Comm):
         The mesh, its facet tags (top face TOP, bottom BOTTOM) and h.
     """
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     h = H0 / args.refine
     x_start, x_end = track(args)
     # the band holds the contact zone (half-width below sqrt(2Rd)) all along the track
@@ -137,7 +137,7 @@ def build_mesh(args: argparse.Namespace, comm: MPI.Comm):
                            "MeshSizeFromCurvature"):
                 gmsh.option.setNumber(f"Mesh.{option}", 0)
             gmsh.model.mesh.generate(2)
-        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+        domain, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
     finally:
         gmsh.finalize()
     return domain, facet_tags, h
@@ -248,7 +248,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
     comm = MPI.COMM_WORLD
     clock = time.perf_counter()
     domain, facet_tags, h = build_mesh(args, comm)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     u = fem.Function(V, name="u")
     bottom = fem.locate_dofs_topological(V, 1, facet_tags.find(BOTTOM))
     bcs = [fem.dirichletbc(np.zeros(2, dtype=PETSc.ScalarType), bottom, V)]

@@ -3,18 +3,18 @@
 A gmsh block [0, 2] × [0, 1] (plane strain, small-strain elasticity written in
 UFL here — any material law works the same way) is pushed by its top face onto
 a rigid disk of radius 1 below it; the dual mortar basis (LcLS*) carries the
-contact pressure. Run: ``/usr/bin/python3 demos/quickstart.py`` (or with
+contact pressure. Run: ``python3 demos/quickstart.py`` (or with
 ``mpirun -n 2``); results in ``results/quickstart*.xdmf``.
 """
 import gmsh
 import numpy as np
 import ufl
 from dolfinx import fem
-from dolfinx.io import gmshio
 from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidSphere
+from dolfinx_mortar.io.gmsh_io import model_to_mesh  # DOLFINx's, in every supported release
 
 BOTTOM, TOP = 1, 2                       # facet tags: the slave surface and the loaded face
 comm = MPI.COMM_WORLD
@@ -29,10 +29,10 @@ if comm.rank == 0:
     gmsh.model.addPhysicalGroup(2, [1], 1)
     gmsh.option.setNumber("Mesh.CharacteristicLengthMax", 0.05)
     gmsh.model.mesh.generate(2)
-mesh, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+mesh, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
 gmsh.finalize()
 
-V = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
+V = fem.functionspace(mesh, ("Lagrange", 1, (mesh.geometry.dim,)))
 u, v = fem.Function(V, name="u"), ufl.TestFunction(V)
 E, nu = 1.0, 0.3
 mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))

@@ -2,7 +2,7 @@
 
 The six mortar bases for the contact pressure of Duong, De Lorenzis and Sauer
 (GLS, GLS*, LmLS, LmLS*, LcLS*, LcLS) on B-spline/NURBS and Lagrange slave
-surfaces; see DESIGN.md for the mathematics.
+surfaces; see docs/DESIGN.md for the mathematics.
 
 Subpackages, one per layer of the Python library:
 
@@ -22,8 +22,18 @@ The names that need DOLFINx (``ContactTerm``, ``NonlinearContactProblem``,
 use, so that the bases and kernels work without it.
 """
 from importlib import import_module
+from importlib.metadata import PackageNotFoundError, version
 
-from dolfinx_mortar import kinds, quiet_logs
+
+def _package_version() -> str:
+    # the one version string is the package metadata's (pyproject.toml)
+    try:
+        return version("dolfinx_mortar")
+    except PackageNotFoundError:      # a source tree that was never installed
+        return "unknown"
+
+
+from dolfinx_mortar import kinds
 from dolfinx_mortar.bases import basis
 from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import KIND_NAMES, parse_kind
@@ -33,6 +43,7 @@ _LAZY = {
     "ContactTerm": "dolfinx_mortar.contact.term",
     "NonlinearContactProblem": "dolfinx_mortar.solver.nonlinear_problem",
     "reaction_force": "dolfinx_mortar.solver.nonlinear_problem",
+    "NewtonSolver": "dolfinx_mortar.solver.newton_solver",
     "LoadPathSolver": "dolfinx_mortar.solver.load_path",
     "read_xdmf_series": "dolfinx_mortar.io.read_series",
     "ContactProblem": "dolfinx_mortar.solver.elastic",
@@ -44,12 +55,15 @@ _LAZY = {
 
 __all__ = ["basis", "kinds", "lagrange", "nurbs", "MortarBasis", "KIND_NAMES",
            "parse_kind", *_LAZY]
-__version__ = "0.2.0"
-
-quiet_logs.install()
+__version__ = _package_version()
 
 
 def __getattr__(name: str):
     if name in _LAZY:
         return getattr(import_module(_LAZY[name]), name)
     raise AttributeError(f"module 'dolfinx_mortar' has no attribute '{name}'")
+
+
+def __dir__() -> list[str]:
+    # the lazily imported names too: dir(dolfinx_mortar) shows what the package offers
+    return sorted(set(globals()) | set(__all__))

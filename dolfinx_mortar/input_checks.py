@@ -6,12 +6,13 @@ not later inside FFCx, the compiler or MUMPS.
 from __future__ import annotations
 
 import ctypes
-from typing import Iterable, Optional
+from typing import Callable, Iterable, Optional
 
 import dolfinx
 import numpy as np
 from petsc4py import PETSc
 
+from dolfinx_mortar import dolfinx_compat
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
 
@@ -77,10 +78,9 @@ def _bad_cells_message(mesh: dolfinx.mesh.Mesh) -> Optional[str]:
         return None
     cells = f2c.array[f2c.offsets[interior][:, None] + np.arange(2)]      # (facets, 2)
     x = mesh.geometry.x[:, :gdim]
-    geometry = mesh.geometry.dofmap
-    cell_nodes = geometry.array.reshape(-1, geometry.offsets[1])
+    cell_nodes = dolfinx_compat.geometry_dofmap(mesh)
     # the facets' vertices' geometry nodes (the first nodes of a facet's closure)
-    facet_nodes = dolfinx.cpp.mesh.entities_to_geometry(mesh._mesh, fdim, interior, False)
+    facet_nodes = dolfinx.mesh.entities_to_geometry(mesh, fdim, interior, False)
     corners = x[facet_nodes[:, :tdim]]                                       # (f, tdim, gdim)
     if gdim == 2:
         t = corners[:, 1] - corners[:, 0]
@@ -115,28 +115,38 @@ def _petsc_library() -> Optional[ctypes.CDLL]:
     return None
 
 
+def _option_used_query() -> Optional[Callable[[str], bool]]:
+    """``name -> whether an object read the option`` (name without the '-')."""
+    db = PETSc.Options()
+    if hasattr(db, "used"):            # petsc4py 3.25 (not 3.22)
+        return lambda name: bool(db.used(name))
+    # older petsc4py: PetscOptionsUsed of the library petsc4py itself loaded
+    lib = _petsc_library()
+    if lib is None:
+        return None
+    query = lib.PetscOptionsUsed
+    query.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
+
+    def used(name: str) -> bool:
+        flag = ctypes.c_int(0)
+        return query(None, name.encode(), ctypes.byref(flag)) != 0 or bool(flag.value)
+
+    return used
+
+
 def unused_petsc_options(prefix: str, ignore: Iterable[str] = ()) -> list[str]:
     """Options under ``prefix`` in PETSc's database that no object has read.
 
-    petsc4py 3.18 does not expose ``PetscOptionsUsed``; it is called through
-    ctypes on the library petsc4py itself loaded. ``ignore`` names options
-    (without the prefix) that may stay unused, e.g. defaults for a solver
-    the user replaced. Returns [] when the library cannot be found.
+    ``ignore`` names options (without the prefix) that may stay unused, e.g.
+    defaults for a solver the user replaced. Returns [] when PETSc cannot be
+    asked (a petsc4py without ``Options.used`` whose library is not found).
     """
-    lib = _petsc_library()
-    if lib is None:
+    used = _option_used_query()
+    if used is None:
         return []
-    used_query = lib.PetscOptionsUsed
-    used_query.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
     skip = {prefix + name for name in ignore}
-    unused = []
-    for name in PETSc.Options().getAll():
-        if not name.startswith(prefix) or name in skip:
-            continue
-        used = ctypes.c_int(0)
-        if used_query(None, name.encode(), ctypes.byref(used)) == 0 and not used.value:
-            unused.append("-" + name)
-    return sorted(unused)
+    return sorted("-" + name for name in PETSc.Options().getAll()
+                  if name.startswith(prefix) and name not in skip and not used(name))
 
 
 def check_tags(mesh, facet_tags, tags: Iterable) -> None:

@@ -226,7 +226,7 @@ def assemble_global_blocks(layout: NodeLayout, row_global: IntArray, col_global:
 class MassMatrixSolver:
     """A sparse direct factorization of the global slave mass matrix ``L``.
 
-    ``L`` is never inverted densely (DESIGN.md §2). The default is a Cholesky
+    ``L`` is never inverted densely (docs/DESIGN.md, §Bases). The default is a Cholesky
     factorization by MUMPS; the PETSc options database can change it under the
     prefix :data:`MASS_SOLVER_PREFIX`.
     """

@@ -2,7 +2,7 @@
 
 Every decision "is this length, area or distance zero?" is taken against
 ``GEOMETRIC_TOLERANCE × length scale``, where the length scale is the larger
-of the coordinates' magnitude and the geometry's extent (DESIGN.md §6): the
+of the coordinates' magnitude and the geometry's extent (docs/DESIGN.md, §Tolerances): the
 round-off in a computed length grows with the first, and differs from one CPU
 to the next, so a computed float is never compared with exact zero or with a
 tolerance relative to itself. The constant is the C++ kernels' own

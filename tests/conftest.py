@@ -1,7 +1,9 @@
 """Shared pytest set-up.
 
 - The test helpers live in ``tests/support``; the test folders mirror the
-  package's subpackages, so put ``tests/`` on the path once, here.
+  package's subpackages, so put ``tests/`` on the path once, here, and
+  ``demos/`` for the scenes the demos share (``demo_support``, not part of
+  the installed library).
 - Each MPI rank runs its own pytest session: give each its own temporary root.
   pytest prunes old numbered folders under /tmp/pytest-of-<user>; two ranks
   sharing that root can delete each other's files mid-test.
@@ -13,6 +15,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(1, str(Path(__file__).resolve().parents[1] / "demos"))
 
 
 def pytest_configure(config):

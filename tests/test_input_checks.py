@@ -177,6 +177,6 @@ def test_cell_tags_instead_of_facet_tags_are_reported():
 
 def test_unsupported_space_is_reported():
     domain, tags = _unit_square_with_tags(3)
-    V = fem.FunctionSpace(domain, ("Lagrange", 3))
+    V = fem.functionspace(domain, ("Lagrange", 3))
     with pytest.raises(ValueError, match="degree 1 or 2"):
         facet_surface(V, tags, 3)

@@ -1,1 +1,1 @@
-"""The six mortar bases of the contact pressure (DESIGN.md §2)."""
+"""The six mortar bases of the contact pressure (docs/DESIGN.md, §Bases)."""

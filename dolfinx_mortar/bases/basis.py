@@ -1,4 +1,4 @@
-"""The six mortar bases for the contact pressure on a slave surface (DESIGN.md §2).
+"""The six mortar bases for the contact pressure on a slave surface (docs/DESIGN.md, §Bases).
 
 For every kind, ``M_A`` is represented through the slave basis ``N``:
 

@@ -2,7 +2,7 @@
 
 GLS and GLS* couple every slave node to every other (``M_A = (N L⁻¹)_A``), so
 their contact stiffness is dense. The step is instead taken from a sparse
-saddle-point system (DESIGN.md §3), factorized with MUMPS and applied as a
+saddle-point system (docs/DESIGN.md, §Augmented step), factorized with MUMPS and applied as a
 PETSc python preconditioner.
 """
 from __future__ import annotations
@@ -21,7 +21,7 @@ FloatArray = npt.NDArray[np.float64]
 class AugmentedNewtonStep:
     """Exact Newton step for GLS/GLS* through the sparse augmented system.
 
-    With y = d̄ and z = L⁻¹ ω⟨y⟩ (DESIGN.md §3), the Newton matrix
+    With y = d̄ and z = L⁻¹ ω⟨y⟩ (docs/DESIGN.md, §Augmented step), the Newton matrix
     ``K + Ĝᵀ L⁻¹ diag(ωH) L⁻¹ Ĝ`` is the Schur complement of
 
         [ K    0     Ĝᵀ ] [Δu]   [r]

@@ -1,6 +1,6 @@
 """Contact with an elastic master, bases and segmentation in the current configuration.
 
-``basis_configuration="current"`` with a master surface (DESIGN.md §3, finite
+``basis_configuration="current"`` with a master surface (docs/DESIGN.md, §Finite
 deformation): the segments, the projection χ and the averaged slave normals
 all move with u. ``ĝ_A(u) = ∫ φ_A d`` and its exact first and second
 derivatives with respect to every node it depends on — the slave cell's, the

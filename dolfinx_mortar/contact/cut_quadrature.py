@@ -1,6 +1,6 @@
 """Quadrature on the penetrating part {d > 0} of facets cut by the contact boundary.
 
-The pointwise active set integrates ``M_A ε⟨d⟩`` (DESIGN.md §3), whose kink at
+The pointwise active set integrates ``M_A ε⟨d⟩`` (docs/DESIGN.md, §Active sets), whose kink at
 ``d = 0`` spoils Gauss rules on cut cells. Each cut cell is divided into
 sub-simplices in reference coordinates (lines: ``k`` pieces; triangles and
 quadrilaterals: ``k²`` or ``2k²`` triangles); on every sub-edge that changes

@@ -1,6 +1,6 @@
 """Contact against a rigid obstacle with the bases in the current configuration.
 
-``basis_configuration="current"`` (DESIGN.md §3, finite deformation): the slave
+``basis_configuration="current"`` (docs/DESIGN.md, §Finite deformation): the slave
 surface, its area element, its lumped weights W and therefore its mortar
 functions follow the displacement u; the gap ``d = −φ(x + u)`` is exact. For
 the local kinds every nodal gap is ``y_A = ĝ_A W_A^{−k}`` with
@@ -108,7 +108,7 @@ class CurrentSurfaceGap(GapModelBase):
     quadrature_degree
         Degree of the rule for W on every slave facet (default 2p + 2).
     pointwise
-        The pointwise active set (DESIGN.md §3): the nodal pressures come from
+        The pointwise active set (docs/DESIGN.md, §Active sets): the nodal pressures come from
         ``ĝ⁺_A = ∫ φ_A ⟨d⟩ da`` evaluated at the quadrature points (cells and
         segments are not split at d = 0). It has no potential; its virtual
         work is the nodal one with ``⟨y_A⟩`` replaced by ``y⁺_A = ĝ⁺_A W_A^{−k}``,

@@ -1,4 +1,4 @@
-"""Penalty mortar contact terms for the Newton solver (DESIGN.md §3).
+"""Penalty mortar contact terms for the Newton solver (docs/DESIGN.md, §Penalty contact).
 
 With nodal gaps ``d̄_A`` and their derivative ``G = ∂d̄/∂u`` (a sparse matrix,
 slave functions × displacement dofs), the penalty potential
@@ -344,10 +344,10 @@ class MortarGap(GapModelBase):
     def raw_gaps(self, u):
         """Nodal gaps, G (a copy), None (no curvature), and (pointwise) d̄⁺, G⁺."""
         u.x.scatter_forward()
-        gaps = self.nodal_gaps(u.vector)
+        gaps = self.nodal_gaps(u.x.petsc_vec)
         gaps_plus = G_plus = None
         if self.pointwise:
-            gaps_plus, G_plus = self.points.positive_gaps(u.vector)
+            gaps_plus, G_plus = self.points.positive_gaps(u.x.petsc_vec)
         return gaps, self.G.copy(), None, gaps_plus, G_plus
 
     def nodal_gaps(self, u: PETSc.Vec) -> FloatArray:

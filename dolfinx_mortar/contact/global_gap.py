@@ -1,6 +1,6 @@
 """The gap model of GLS and GLS*: nodal gaps through the global mass matrix.
 
-``d̄ = L⁻¹ ĝ(u)`` with ``ĝ_B = ∫ N_B d`` (DESIGN.md §3). ``M_A`` has global
+``d̄ = L⁻¹ ĝ(u)`` with ``ĝ_B = ∫ N_B d`` (docs/DESIGN.md, §Augmented step). ``M_A`` has global
 support, so ``G = L⁻¹ Ĝ`` is dense: only the sparse ``Ĝ = ∂ĝ/∂u`` and ``L``
 are assembled, and the Newton step solves the augmented system
 (:class:`~dolfinx_mortar.contact.augmented.AugmentedNewtonStep`).

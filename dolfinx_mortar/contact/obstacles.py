@@ -1,4 +1,4 @@
-"""Rigid analytic obstacles: they are never meshed (DESIGN.md §3).
+"""Rigid analytic obstacles: they are never meshed (docs/DESIGN.md, §Penalty contact).
 
 An obstacle is its signed distance φ (positive outside the obstacle), with the
 gradient and Hessian the exact contact Jacobian needs. The penetration of a

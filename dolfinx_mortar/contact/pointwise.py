@@ -1,4 +1,4 @@
-"""The pointwise active set: ``d̄⁺_A = ∫ M̄_A ⟨d⟩`` and its derivative (DESIGN.md §3).
+"""The pointwise active set ``d̄⁺_A = ∫ M̄_A ⟨d⟩``, its derivative (docs/DESIGN.md, §Active sets).
 
 With the nodal active set the penalty acts on ``⟨d̄_A⟩``; with the pointwise
 one the nodal pressure is ``p_A = ε d̄⁺_A``, integrated only where the slave

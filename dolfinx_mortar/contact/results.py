@@ -162,7 +162,7 @@ class ContactResults:
         pairs = coupling.pairs
         nodes = coupling.master_global_ids[coupling.master_cells[pairs[:, 1]]]
         dofs = (nodes[..., None] * gdim + np.arange(gdim)).ravel().astype(PETSc.IntType)
-        values = _gather_entries(self.u.vector, dofs).reshape(nodes.shape + (gdim,))
+        values = _gather_entries(self.u.x.petsc_vec, dofs).reshape(nodes.shape + (gdim,))
         master_mean = values.mean(axis=1)
         count = np.zeros(self.slave.layout.size_local)
         total = np.zeros_like(u_nodes)

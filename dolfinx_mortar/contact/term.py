@@ -21,7 +21,6 @@ import time
 from contextlib import contextmanager
 from typing import Iterator, Optional, Sequence
 
-import dolfinx.la
 import numpy as np
 import numpy.typing as npt
 from dolfinx import fem
@@ -36,6 +35,7 @@ from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.results import ContactResults
 from dolfinx_mortar.contact.sparse_products import PatternTrackingAdd
 from dolfinx_mortar.contact.state import ContactState, GapModel
+from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.input_checks import check_cells, check_contact_tags
 from dolfinx_mortar.surfaces.facet_surface import facet_surface, nodal_displacement
@@ -64,11 +64,11 @@ class ContactTerm(ContactResults):
         (:mod:`dolfinx_mortar.contact.obstacles`); it may be moved between
         load steps (``obstacle.move_to``).
     kind
-        Mortar basis kind, any of the six (DESIGN.md §2).
+        Mortar basis kind, any of the six (docs/DESIGN.md, §Bases).
     penalty
         ε, pressure per length (consistent scaling).
     scaling
-        ``"consistent"`` (default) or ``"seed"`` (DESIGN.md §3).
+        ``"consistent"`` (default) or ``"seed"`` (docs/DESIGN.md, §Scalings).
     active_set
         ``"nodal"`` (default, penalty on ⟨d̄_A⟩) or ``"pointwise"``
         (``p_A = ε∫M̄_A⟨d⟩``, unsymmetric exact Jacobian).
@@ -160,7 +160,7 @@ class ContactTerm(ContactResults):
             model = current_model(self.options, self.slave, self.master, self.obstacle)
         else:
             model = frozen_model(self.options, self.slave, self.master, self.obstacle,
-                                 u_nodes, None if u_nodes is None else self.u.vector.copy())
+                                 u_nodes, None if u_nodes is None else self.u.x.petsc_vec.copy())
             self._built_at = None if u_nodes is None else u_nodes.copy()
         self._last_active, self.state = None, None
         self.timings["setup"] = time.perf_counter() - clock
@@ -192,7 +192,7 @@ class ContactTerm(ContactResults):
             return
         current = self.model
         self.model = frozen_model(self.options, self.slave, self.master, self.obstacle,
-                                  nodal_displacement(self.slave, self.u), self.u.vector.copy())
+                                  nodal_displacement(self.slave, self.u), self.u.x.petsc_vec.copy())
         try:
             yield
         finally:
@@ -209,14 +209,14 @@ class ContactTerm(ContactResults):
         return self.model.augmented
 
     # -- PETSc assembly --------------------------------------------------------------
-    def mask(self, bcs: Sequence[fem.DirichletBCMetaClass] = ()) -> PETSc.Vec:
+    def mask(self, bcs: Sequence[fem.DirichletBC] = ()) -> PETSc.Vec:
         """1 on free dofs, 0 on the dofs of ``bcs`` (the contact terms skip those)."""
         key = tuple(id(bc) for bc in bcs)
         if key not in self._masks:
             index_map = self.V.dofmap.index_map
-            m = dolfinx.la.create_petsc_vector(index_map, self.V.dofmap.index_map_bs)
+            m = ghosted_vector(index_map, self.V.dofmap.index_map_bs)
             m.set(1.0)
-            fem_petsc.set_bc(m, list(bcs), scale=0.0)
+            fem_petsc.set_bc(m, list(bcs), alpha=0.0)
             self._masks[key] = m
         return self._masks[key]
 
@@ -300,7 +300,7 @@ class ContactTerm(ContactResults):
         ksp.getPC().setType("python")
         ksp.getPC().setPythonContext(self._augmented)
 
-    def create_matrix(self, a: fem.FormMetaClass, bcs: Sequence = ()) -> PETSc.Mat:
+    def create_matrix(self, a: fem.Form, bcs: Sequence = ()) -> PETSc.Mat:
         """A matrix whose pattern holds the bilinear form ``a`` and the contact
         stiffness (of every active set), with ``a`` assembled in it."""
         A = fem_petsc.create_matrix(a)

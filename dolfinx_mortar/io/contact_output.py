@@ -14,6 +14,7 @@ from typing import Sequence
 import numpy as np
 from dolfinx import fem
 
+from dolfinx_mortar import dolfinx_compat
 from dolfinx_mortar.io.surface_output import SlaveSurfaceOutput, surface_output_path
 from dolfinx_mortar.io.xdmf_series import XdmfSeries
 
@@ -43,12 +44,12 @@ class ContactOutput:
                 p = p.with_name(p.stem + str(i) + p.suffix)
             self.surface_outputs.append(SlaveSurfaceOutput(term.slave, p))
         V = u.function_space
-        degree = mesh.geometry.cmap.degree
-        self.V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
+        degree = dolfinx_compat.coordinate_element(mesh).degree
+        self.V1 = fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))
         self.Q, q_to_v = V.sub(0).collapse()
         self.q_nodes = np.asarray(q_to_v) // V.dofmap.index_map_bs
-        self.Q1 = (fem.FunctionSpace(mesh, ("Lagrange", degree))
-                   if self.Q.ufl_element().degree() != degree else None)
+        self.Q1 = (fem.functionspace(mesh, ("Lagrange", degree))
+                   if self.Q.ufl_element().degree != degree else None)
 
     def write(self, t: float, states: Sequence) -> None:
         """Add the step at pseudo-time ``t`` with each term's contact state."""

@@ -11,7 +11,7 @@ This partitioner keeps DOLFINx's graph partition for the bulk and deals out
 the cells next to the contact facets separately, by recursive coordinate
 bisection, so that every rank gets an equal share of them in one compact
 piece. Balancing two quantities at once is what METIS calls a
-multi-constraint partition; DOLFINx 0.5.2 exposes no weights to its graph
+multi-constraint partition; DOLFINx (0.9 to 0.11) exposes no weights to its graph
 partitioners (SCOTCH, ParMETIS, KaHIP), so the two are balanced one after the
 other here. The contact cells moved off their graph part add ghosts along the
 cut of the contact layer only: a layer one cell thick.
@@ -27,6 +27,8 @@ from scipy.optimize import linear_sum_assignment
 from scipy.spatial import cKDTree
 
 from dolfinx import cpp as _cpp
+
+from dolfinx_mortar import dolfinx_compat
 
 FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
@@ -177,4 +179,4 @@ def contact_balanced_partitioner(comm: MPI.Comm, contact_cells: BoolArray,
                 owner, np.arange(len(owner) + 1, dtype=np.int32))
         return _ghost_ranks(comm, graph, owner)
 
-    return _cpp.mesh.create_cell_partitioner(partition)
+    return dolfinx_compat.create_cell_partitioner(partition)

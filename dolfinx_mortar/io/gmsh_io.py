@@ -1,49 +1,33 @@
 """Reading gmsh models and files into DOLFINx, with the names of their
 physical groups, optionally with the contact surfaces spread over the ranks.
 
-DOLFINx 0.5.2's ``gmshio.read_from_msh`` finalizes gmsh and then returns an
-undefined name on the reading rank, so it cannot be used; this opens the file
-on one rank and hands the model to ``gmshio.model_to_mesh`` itself.
+The model is opened on one rank and handed to DOLFINx's ``model_to_mesh``
+(through :mod:`dolfinx_mortar.dolfinx_compat`, which hides where that lives
+and what it returns in each DOLFINx release).
 """
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path
-from typing import Callable, Iterator, Optional, Sequence, Union
+from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
 from mpi4py import MPI
 
-
-@contextlib.contextmanager
-def _gmshio_create_mesh(replacement: Callable) -> Iterator[None]:
-    """Make ``gmshio.model_to_mesh`` create its mesh with ``replacement``.
-
-    DOLFINx 0.5.2's ``model_to_mesh`` has no partitioner argument (0.6 added
-    one) and calls the ``create_mesh`` of its module's namespace, so that
-    name is swapped for the duration of the call instead of copying the
-    function's 90 lines.
-    """
-    from dolfinx.io import gmshio
-    original = gmshio.create_mesh
-    gmshio.create_mesh = replacement
-    try:
-        yield
-    finally:
-        gmshio.create_mesh = original
+from dolfinx_mortar import dolfinx_compat
 
 
 def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: int = 3,
                   balance_facets: Optional[Sequence[int]] = None):
-    """``dolfinx.io.gmshio.model_to_mesh``, optionally with the cells next to
-    some facets spread evenly over the ranks.
+    """DOLFINx's ``model_to_mesh`` as ``(mesh, cell_tags, facet_tags)`` in
+    every supported release, optionally with the cells next to some facets
+    spread evenly over the ranks.
 
     Parameters
     ----------
     model
         The gmsh model, built on ``rank``.
     comm, rank, gdim
-        As for ``gmshio.model_to_mesh``.
+        As for DOLFINx's ``model_to_mesh``.
     balance_facets
         Physical tags of the facet groups (the contact surfaces) whose
         adjacent cells every rank should get an equal share of
@@ -59,11 +43,11 @@ def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: int = 3,
     ValueError
         If a tag in ``balance_facets`` is no physical group of facets.
     """
-    from dolfinx.io import gmshio
     if balance_facets is None:
-        return gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+        return dolfinx_compat.model_to_mesh(model, comm, rank, gdim=gdim)
     tags = [int(t) for t in balance_facets]
     surface_nodes = None
+    x = None
     error = None
     if comm.rank == rank:
         tdim = max(dim for dim, _ in model.getPhysicalGroups())
@@ -73,31 +57,46 @@ def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: int = 3,
             error = (f"balance_facets {missing} are no physical groups of facets "
                      f"(dimension {tdim - 1}) of the gmsh model; present: {sorted(present)}")
         else:
-            # gmsh numbers nodes from 1, model_to_mesh from 0
+            # gmsh numbers nodes from 1, model_to_mesh's rows of x from 0
             surface_nodes = [model.mesh.getNodesForPhysicalGroup(tdim - 1, tag)[0].astype(
                 np.int64) - 1 for tag in tags]
+            node_tags, coordinates, _ = model.mesh.getNodes()
+            x = np.empty((len(node_tags), gdim))
+            x[node_tags.astype(np.int64) - 1] = coordinates.reshape(-1, 3)[:, :gdim]
     error = comm.bcast(error, root=rank)
     if error:
         raise ValueError(error)
     if comm.size == 1:
-        return gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+        return dolfinx_compat.model_to_mesh(model, comm, rank, gdim=gdim)
+    partitioner = _contact_cell_partitioner(comm, x, surface_nodes or [], gdim)
+    return dolfinx_compat.model_to_mesh(model, comm, rank, gdim=gdim, partitioner=partitioner)
 
-    def create_mesh(comm_, cells, x, domain, **kwargs):
-        from dolfinx import cpp as _cpp
-        from dolfinx.mesh import create_mesh as dolfinx_create_mesh
-        from dolfinx_mortar.io.contact_partitioner import (cells_near_contact,
-                                                           contact_balanced_partitioner)
-        cell_type = _cpp.mesh.to_type(domain.ufl_cell().cellname())
-        vertices = np.asarray(cells)[:, :_cpp.mesh.cell_num_vertices(cell_type)]
-        facet_type = _cpp.mesh.cell_entity_type(cell_type, _cpp.mesh.cell_dim(cell_type) - 1, 0)
-        contact = cells_near_contact(vertices, x, surface_nodes or [],
-                                     _cpp.mesh.cell_num_vertices(facet_type))
-        centroids = x[vertices].mean(axis=1) if len(vertices) else np.empty((0, x.shape[1]))
-        partitioner = contact_balanced_partitioner(comm, contact, centroids)
-        return dolfinx_create_mesh(comm_, cells, x, domain, partitioner=partitioner, **kwargs)
 
-    with _gmshio_create_mesh(create_mesh):
-        return gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+def _contact_cell_partitioner(comm: MPI.Comm, x: Optional[np.ndarray],
+                              surface_nodes: list, gdim: int) -> Callable:
+    """A cell partitioner that finds the contact cells among the cells it is
+    given (their vertices, numbered as the rows of the model's nodes ``x``)
+    and balances them (:func:`contact_balanced_partitioner`)."""
+    from dolfinx import cpp as _cpp
+
+    from dolfinx_mortar.io.contact_partitioner import (cells_near_contact,
+                                                       contact_balanced_partitioner)
+
+    def partition(comm_wrapper, nparts: int, cell_types, cells):
+        cell_type = cell_types[0]
+        num_vertices = _cpp.mesh.cell_num_vertices(cell_type)
+        vertices = np.asarray(cells[0], dtype=np.int64).reshape(-1, num_vertices)
+        if len(vertices):
+            facet_type = _cpp.mesh.cell_entity_type(cell_type, _cpp.mesh.cell_dim(cell_type) - 1, 0)
+            contact = cells_near_contact(vertices, x, surface_nodes,
+                                         _cpp.mesh.cell_num_vertices(facet_type))
+            centroids = x[vertices].mean(axis=1)
+        else:
+            contact, centroids = np.zeros(0, dtype=bool), np.empty((0, gdim))
+        balanced = contact_balanced_partitioner(comm, contact, centroids)
+        return balanced(comm_wrapper, nparts, cell_types, cells)
+
+    return partition
 
 
 def read_gmsh(path: Union[str, Path], comm: MPI.Comm, gdim: int = 3,

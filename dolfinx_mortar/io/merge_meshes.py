@@ -25,6 +25,8 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
+from dolfinx_mortar import dolfinx_compat
+
 #: cell tag values of the two bodies in the merged mesh
 BODY_A, BODY_B = 1, 2
 
@@ -36,7 +38,8 @@ def _owned_node_data(domain):
     node_map = geometry.index_map()
     num_cells = domain.topology.index_map(domain.topology.dim).size_local
     # nodes per cell from the element: a rank may hold no cell of a small mesh
-    dofmap = geometry.dofmap.array.reshape(-1, geometry.cmap.create_dof_layout().num_dofs)
+    dofmap = dolfinx_compat.geometry_dofmap(domain).reshape(
+        -1, dolfinx_compat.coordinate_element(domain).create_dof_layout().num_dofs)
     x = geometry.x[:node_map.size_local, :gdim]
     local_to_global = np.asarray(node_map.local_to_global(
         np.arange(node_map.size_local + node_map.num_ghosts, dtype=np.int32)), dtype=np.int64)
@@ -58,18 +61,25 @@ def _owned_tagged_facets(domain, facet_tags):
     topology.create_connectivity(tdim, fdim)
     owned = facet_tags.indices < topology.index_map(fdim).size_local
     facets = np.asarray(facet_tags.indices[owned], dtype=np.int32)
-    layout = domain.geometry.cmap.create_dof_layout()
+    layout = dolfinx_compat.coordinate_element(domain).create_dof_layout()
     num_facets = cpp.mesh.cell_num_entities(topology.cell_type, fdim)
     closure = np.array([layout.entity_closure_dofs(fdim, i) for i in range(num_facets)],
                        dtype=np.int32)
-    geometry = domain.geometry.dofmap
+    geometry = dolfinx_compat.geometry_dofmap(domain)
     f_to_c, c_to_f = topology.connectivity(fdim, tdim), topology.connectivity(tdim, fdim)
     nodes = np.empty((len(facets), layout.num_entity_closure_dofs(fdim)), dtype=np.int32)
     for row, f in enumerate(facets):
         c = f_to_c.links(f)[0]
         local = int(np.flatnonzero(c_to_f.links(c) == f)[0])
-        nodes[row] = geometry.links(c)[closure[local]]
+        nodes[row] = geometry[c][closure[local]]
     return nodes, np.asarray(facet_tags.values[owned], dtype=np.int32)
+
+
+def _adjacency(entities: npt.NDArray) -> object:
+    """Rows of entity vertices as the adjacency list ``meshtags_from_entities`` takes."""
+    entities = np.asarray(entities, dtype=np.int32).reshape(len(entities), -1)
+    offsets = np.arange(len(entities) + 1, dtype=np.int32) * entities.shape[1]
+    return dolfinx_compat.adjacency_list(entities.ravel(), offsets)
 
 
 def _global_values(comm: MPI.Comm, values: npt.ArrayLike) -> set:
@@ -111,8 +121,8 @@ def merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b, comm: Optional[MPI.
         bodies without being in ``shared_tags``.
     """
     import ufl
-    from dolfinx import cpp
-    from dolfinx.mesh import create_mesh, meshtags_from_entities
+    from dolfinx.io import distribute_entity_data
+    from dolfinx.mesh import meshtags_from_entities
 
     comm = mesh_a.comm if comm is None else comm
     for name, domain in (("mesh_a", mesh_a), ("mesh_b", mesh_b)):
@@ -122,7 +132,7 @@ def merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b, comm: Optional[MPI.
     if cell_a != cell_b:
         raise ValueError(f"cannot merge a {cell_a.name} mesh with a {cell_b.name} mesh: "
                          "both meshes need the same cell type")
-    deg_a, deg_b = mesh_a.geometry.cmap.degree, mesh_b.geometry.cmap.degree
+    deg_a, deg_b = (dolfinx_compat.coordinate_element(m).degree for m in (mesh_a, mesh_b))
     if deg_a != deg_b:
         raise ValueError(f"cannot merge geometry degree {deg_a} with geometry degree {deg_b}: "
                          "both meshes need the same coordinate element")
@@ -132,7 +142,7 @@ def merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b, comm: Optional[MPI.
     tdim = mesh_a.topology.dim
     for name, tags, domain in (("facet_tags_a", facet_tags_a, mesh_a),
                                ("facet_tags_b", facet_tags_b, mesh_b)):
-        if tags.dim != tdim - 1 or tags.mesh is not domain._mesh:
+        if tags.dim != tdim - 1 or not dolfinx_compat.tags_belong_to(tags, domain):
             raise ValueError(f"{name} must be facet tags (dim {tdim - 1}) of its own mesh, "
                              f"got dim {tags.dim}")
 
@@ -172,14 +182,14 @@ def merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b, comm: Optional[MPI.
     x = np.vstack([x_a, x_b])
     # a new UFL domain: create_mesh ties the one it gets to the new mesh
     ufl_domain = ufl.Mesh(mesh_a.ufl_domain().ufl_coordinate_element())
-    domain = create_mesh(comm, cells, x, ufl_domain)
+    domain = dolfinx_compat.create_mesh(comm, cells, x, ufl_domain)
 
     # cell tags: every owned input cell with its body
     body = np.concatenate([np.full(len(cells_a), BODY_A, dtype=np.int32),
                            np.full(len(cells_b), BODY_B, dtype=np.int32)])
-    entities, values = cpp.io.distribute_entity_data(domain._mesh, tdim, cells, body)
+    entities, values = distribute_entity_data(domain, tdim, cells, body)
     domain.topology.create_connectivity(tdim, 0)
-    cell_tags = meshtags_from_entities(domain, tdim, cpp.graph.AdjacencyList_int32(entities),
+    cell_tags = meshtags_from_entities(domain, tdim, _adjacency(entities),
                                        values.astype(np.int32))
     cell_tags.name = "Cell tags"
 
@@ -189,11 +199,9 @@ def merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b, comm: Optional[MPI.
     owned_b = facet_tags_b.indices < mesh_b.topology.index_map(tdim - 1).size_local
     facet_nodes = np.vstack([new_a[facets_a], new_b[facets_b]]).astype(np.int64)
     facet_values = np.concatenate([tag_values_a, values_b[owned_b]]).astype(np.int32)
-    entities, values = cpp.io.distribute_entity_data(domain._mesh, tdim - 1, facet_nodes,
-                                                     facet_values)
+    entities, values = distribute_entity_data(domain, tdim - 1, facet_nodes, facet_values)
     domain.topology.create_connectivity(tdim - 1, tdim)
-    facet_tags = meshtags_from_entities(domain, tdim - 1,
-                                        cpp.graph.AdjacencyList_int32(entities),
+    facet_tags = meshtags_from_entities(domain, tdim - 1, _adjacency(entities),
                                         values.astype(np.int32))
     facet_tags.name = "Facet tags"
     return domain, facet_tags, cell_tags

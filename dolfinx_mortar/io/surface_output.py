@@ -1,7 +1,7 @@
 """Fields on the slave surface for XDMF output: ``p̂`` and the mortar traction ``p*``.
 
-``p*`` of the dual kinds is discontinuous across slave facets, and DOLFINx
-0.5.2's XDMF writer only takes Lagrange data of the mesh's own degree. So the
+``p*`` of the dual kinds is discontinuous across slave facets, and DOLFINx's
+XDMF writer only takes Lagrange data of the mesh's own degree. So the
 slave facets become a *broken* surface mesh — every facet with its own copies
 of its nodes — on which a continuous Lagrange function of the facet degree
 holds any element-wise field exactly. Every rank keeps its own facets (a
@@ -13,10 +13,11 @@ from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
+import basix.ufl
 import ufl
-from dolfinx import cpp, fem
-from dolfinx import mesh as dmesh
+from dolfinx import fem
 
+from dolfinx_mortar import dolfinx_compat
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.io.xdmf_series import XdmfSeries
 
@@ -52,20 +53,21 @@ class SlaveSurfaceOutput:
         cells = (offset + np.arange(nc, dtype=np.int64))[:, None] * nd + np.arange(nd)
         rank = comm.rank
 
-        def keep_on_this_rank(_comm, _nparts, _tdim, graph, _ghost_mode):
-            return cpp.graph.AdjacencyList_int32(np.full(graph.num_nodes, rank, dtype=np.int32))
+        def keep_on_this_rank(_comm, _nparts, _cell_types, _cells):
+            return dolfinx_compat.cpp_adjacency_list(np.full(nc, rank, dtype=np.int32),
+                                                     np.arange(nc + 1, dtype=np.int32))
 
-        cell = ufl.Cell(slave.reference.cell, geometric_dimension=gdim)
-        domain = ufl.Mesh(ufl.VectorElement("Lagrange", cell, slave.reference.degree, dim=gdim))
-        self.mesh = dmesh.create_mesh(comm, cells, x, domain, ghost_mode=dmesh.GhostMode.none,
-                                      partitioner=keep_on_this_rank)
+        element = basix.ufl.element("Lagrange", slave.reference.cell, slave.reference.degree,
+                                    shape=(gdim,))
+        self.mesh = dolfinx_compat.create_mesh(comm, cells, x, ufl.Mesh(element),
+                                               partitioner=keep_on_this_rank)
         self.mesh.name = "slave_surface"
-        self.space = fem.FunctionSpace(self.mesh, ("Lagrange", slave.reference.degree))
+        self.space = fem.functionspace(self.mesh, ("Lagrange", slave.reference.degree))
         num_local = self.mesh.topology.index_map(self.mesh.topology.dim).size_local
         original = np.asarray(self.mesh.topology.original_cell_index[:num_local])
         #: slave cell of every surface-mesh cell, and the dofs of its nodes
         self.source = original - offset
-        self.dofs = self.space.dofmap.list.array.reshape(-1, nd)[:num_local]
+        self.dofs = self.space.dofmap.list.reshape(-1, nd)[:num_local]
         self.series = XdmfSeries(self.path, self.mesh)
 
     def function(self, name: str, values: FloatArray) -> fem.Function:

@@ -1,4 +1,4 @@
-"""Mortar operators between a slave and a master surface (DESIGN.md §3–§4).
+"""Mortar operators between a slave and a master surface (docs/DESIGN.md, §Segmentation).
 
 :class:`MortarCoupling` segments one slave–master pair in one configuration and
 keeps the integrals in the slave basis N. Every mortar basis is ``M = N C`` on a
@@ -12,7 +12,7 @@ of any kind by ``Cᵀ·(…)`` without redoing the geometry:
 
 For GLS and GLS*, ``M_A`` has global support: their operators are
 ``S·D_N``, ``S·M_N``, ``S·g_N`` with ``S = L⁻¹`` or ``W L⁻¹``, and only the
-sparse factors are assembled (DESIGN.md §3: never a dense slave block).
+sparse factors are assembled (docs/DESIGN.md, §Bases: never a dense slave block).
 """
 from __future__ import annotations
 
@@ -130,7 +130,7 @@ def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
 
     The master side needs every master facet that may lie below this rank's
     slave facets; gathering the (small) master surface is the simple way
-    (DESIGN.md §5 allows gathering or ghosting).
+    (docs/DESIGN.md, §Parallel).
     """
     comm = surface.layout.comm
     global_ids = surface.layout.global_indices[surface.cells]
@@ -260,7 +260,7 @@ class MortarCoupling:
         #: (the master copy is global, the slave's points are reduced)
         self.length_scale = max(length_scale(xs, comm),
                                 length_scale(master_copy.x) if len(master_copy.x) else 0.0)
-        #: lengths at or below this are zero (DESIGN.md §6)
+        #: lengths at or below this are zero (docs/DESIGN.md, §Tolerances)
         self.zero_length = zero_length(self.length_scale)
         r = _kernels.mortar_integrals(slave.facet_type, xs, slave_cells, self.normals,
                                       master.facet_type, master_copy.x, master_copy.cells,
@@ -278,7 +278,7 @@ class MortarCoupling:
         self.raw_pairs = (r["D"], r["M"], r["gap"])
         T = slave.reference.transform
         if T is not None:
-            # integrals of the transformed basis Ñ = N T (DESIGN.md §2, hard spots)
+            # integrals of the transformed basis Ñ = N T (docs/DESIGN.md, §Quadratic elements)
             self.D_pairs = np.einsum("ba,pbc,cd->pad", T, r["D"], T)
             self.M_pairs = np.einsum("ba,pbc->pac", T, r["M"])
             self.gap_pairs = np.einsum("ba,pb->pa", T, r["gap"])

@@ -86,7 +86,7 @@ class ContactProblem:
         gdim = mesh.geometry.dim
         if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
             raise ValueError(f"need a finite E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
-        if nu > NEARLY_INCOMPRESSIBLE and V.ufl_element().degree() == 1:
+        if nu > NEARLY_INCOMPRESSIBLE and V.ufl_element().degree == 1:
             warnings.warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
                           "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the contact "
                           "force of nu = 0.3); use quadratic elements or a mixed form",
@@ -221,7 +221,7 @@ class ContactProblem:
                                                    shared_tags=shared_tags)
         if master_tag not in {int(t) for t in shared_tags}:
             master_tag = master_tag + tag_offset
-        V = fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
+        V = fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))
         problem = cls(V, facet_tags, slave_tag, master_tag=master_tag, **kwargs)
         problem.cell_tags = cell_tags
         return problem

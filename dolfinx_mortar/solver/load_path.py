@@ -212,9 +212,9 @@ class LoadPathSolver:
                     if any([term.begin_step() for term in self.contacts]):
                         snes.setJacobian(lambda _s, x, A, P: self.problem.J(x, A),
                                          self.problem.refresh_matrix())
-                    saved = u.vector.copy()
+                    saved = u.x.petsc_vec.copy()
                     clock = time.perf_counter()
-                    x = u.vector.copy()
+                    x = u.x.petsc_vec.copy()
                     increment = path.increment(target) if path is not None else None
                     reason, phases, iterations, cause, reference, linear = self.newton_step(
                         snes, x, increment)
@@ -224,14 +224,14 @@ class LoadPathSolver:
                         stepper.failed()
                         if stepper.exhausted:
                             raise ContactDivergenceError(target, failures)
-                        saved.copy(u.vector)
+                        saved.copy(u.x.petsc_vec)
                         u.x.scatter_forward()
                         continue
                     failures = []
-                    x.copy(u.vector)
+                    x.copy(u.x.petsc_vec)
                     u.x.scatter_forward()
                     if path is not None:
-                        path.converged(target, u.vector)
+                        path.converged(target, u.x.petsc_vec)
                     states = [term.evaluate() for term in self.contacts]
                     active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
                     step = StepResult(target, iterations, history,

@@ -16,9 +16,11 @@ from typing import Optional
 import numpy as np
 import scipy.sparse
 import scipy.sparse.csgraph
-from dolfinx import fem, la
+from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
+
+from dolfinx_mortar.dolfinx_compat import ghosted_vector
 
 
 def body_labels(V: fem.FunctionSpace) -> np.ndarray:
@@ -31,11 +33,11 @@ def body_labels(V: fem.FunctionSpace) -> np.ndarray:
     imap = V.dofmap.index_map
     n_local = imap.size_local + imap.num_ghosts
     dofs = V.dofmap.list
-    cells = np.repeat(np.arange(dofs.num_nodes), np.diff(dofs.offsets))
+    n_cells = len(dofs)
+    cells = np.repeat(np.arange(n_cells), dofs.shape[1])
     # a bipartite graph of cells and blocks; its components are the bodies
-    n_cells = dofs.num_nodes
     graph = scipy.sparse.coo_matrix(
-        (np.ones(len(cells)), (cells, n_cells + dofs.array)),
+        (np.ones(len(cells)), (cells, n_cells + dofs.ravel())),
         shape=(n_cells + n_local, n_cells + n_local))
     _, component = scipy.sparse.csgraph.connected_components(graph, directed=False)
     component = component[n_cells:]
@@ -43,7 +45,7 @@ def body_labels(V: fem.FunctionSpace) -> np.ndarray:
     # The parts of one body on different ranks meet at shared blocks: spread
     # the smallest label over them until no rank changes (as many rounds as
     # the body crosses partitions, plus one).
-    labels = la.create_petsc_vector(imap, 1)
+    labels = ghosted_vector(imap, 1)
     comm = V.mesh.comm
     label_of = np.full(component.max(initial=-1) + 1, np.inf)
     np.minimum.at(label_of, component, global_index.astype(float))
@@ -109,13 +111,27 @@ def rigid_body_modes(V: fem.FunctionSpace,
             vectors.append(mode)
     petsc_vectors = []
     for mode in vectors:
-        v = la.create_petsc_vector(imap, bs)
+        v = ghosted_vector(imap, bs)
         with v.localForm() as local:
             local.array[:n_owned * bs] = mode.ravel()
         v.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         petsc_vectors.append(v)
-    la.orthonormalize(petsc_vectors)
+    _orthonormalize(petsc_vectors)
     return PETSc.NullSpace().create(vectors=petsc_vectors, comm=comm)
+
+
+def _orthonormalize(vectors: list[PETSc.Vec]) -> None:
+    """Modified Gram–Schmidt, twice, on PETSc vectors in place.
+
+    DOLFINx's ``la.orthonormalize`` takes its own ``la.Vector``; the
+    nullspace needs PETSc vectors that outlive this function, and a handful
+    of modes does not call for more than this.
+    """
+    for _ in range(2):
+        for i, v in enumerate(vectors):
+            for w in vectors[:i]:
+                v.axpy(-w.dot(v), w)
+            v.normalize()
 
 
 def _owned_node_coordinates(V: fem.FunctionSpace) -> np.ndarray:
@@ -133,8 +149,8 @@ def _owned_node_coordinates(V: fem.FunctionSpace) -> np.ndarray:
     position = fem.Function(V)
     position.interpolate(lambda x: x[:gdim])
     held = np.zeros(imap.size_local + imap.num_ghosts)
-    held[V.dofmap.list.array] = 1.0
-    sums = la.create_petsc_vector(imap, bs + 1)
+    held[V.dofmap.list] = 1.0
+    sums = ghosted_vector(imap, bs + 1)
     with sums.localForm() as local:
         values = local.array.reshape(-1, bs + 1)
         values[:, :bs] = position.x.array.reshape(-1, bs) * held[:, None]

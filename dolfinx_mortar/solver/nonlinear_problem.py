@@ -3,15 +3,18 @@
 
 The residual form ``F(u; v)`` is the user's: any material law, body forces,
 several subdomains, tractions scaled by their own Constants. The contact
-terms add their residual and Jacobian; :meth:`NonlinearContactProblem.F` and
-:meth:`NonlinearContactProblem.J` are what PETSc SNES
-(:meth:`NonlinearContactProblem.configure_snes`) or DOLFINx's ``NewtonSolver``
-call::
+terms add their residual and Jacobian. As DOLFINx's own (0.10+) problem, it
+owns a PETSc SNES configured from ``petsc_options`` under its options prefix::
 
-    problem = NonlinearContactProblem(F, u, contact, bcs)
-    solver = dolfinx.nls.petsc.NewtonSolver(comm, problem)
-    solver.setJ(problem.J, problem.matrix())    # the pattern with the contact's
-    solver.solve(u)
+    problem = NonlinearContactProblem(F, u, contact, bcs,
+                                      petsc_options={"snes_max_it": 30})
+    problem.solve()                       # u now holds the solution
+    assert problem.solver.getConvergedReason() > 0
+
+:meth:`NonlinearContactProblem.F` and :meth:`NonlinearContactProblem.J` are
+the callbacks; DOLFINx's ``NewtonSolver`` path of 0.9 takes them through
+:class:`~dolfinx_mortar.solver.newton_solver.NewtonSolver`, and a load path
+through :class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`.
 """
 from __future__ import annotations
 
@@ -26,6 +29,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.term import ContactTerm
+from dolfinx_mortar.dolfinx_compat import ghosted_vector
+from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 
 
 class NonlinearContactProblem:
@@ -43,15 +48,26 @@ class NonlinearContactProblem:
         Dirichlet conditions; the contact terms skip their dofs.
     J
         The Jacobian form of F (default: its Gateaux derivative in u).
-    form_compiler_params, jit_params
+    petsc_options_prefix
+        The options prefix of :attr:`solver` (command-line options
+        ``-<prefix>snes_…`` apply to it).
+    petsc_options
+        PETSc options for :attr:`solver`, its KSP and PC, without the prefix;
+        over the library's defaults (:data:`~dolfinx_mortar.solver.petsc_options.DEFAULT_OPTIONS`).
+    form_compiler_options, jit_options
         Passed to :func:`dolfinx.fem.form`.
     """
 
     def __init__(self, F: ufl.Form, u: fem.Function,
                  contact: Union[ContactTerm, Sequence[ContactTerm]],
-                 bcs: Sequence[fem.DirichletBCMetaClass] = (), J: Optional[ufl.Form] = None,
-                 form_compiler_params: Optional[dict] = None, jit_params: Optional[dict] = None):
+                 bcs: Sequence[fem.DirichletBC] = (), J: Optional[ufl.Form] = None, *,
+                 petsc_options_prefix: str = "dolfinx_mortar_nonlinear_",
+                 petsc_options: Optional[dict] = None,
+                 form_compiler_options: Optional[dict] = None, jit_options: Optional[dict] = None):
         self.u = u
+        self.petsc_options_prefix = petsc_options_prefix
+        self.petsc_options = dict(petsc_options or {})
+        self._snes: Optional[PETSc.SNES] = None
         self.bcs = list(bcs)
         self.contacts = [contact] if isinstance(contact, ContactTerm) else list(contact)
         if not self.contacts:
@@ -63,12 +79,12 @@ class NonlinearContactProblem:
                 len(self.contacts) > 1 and any(term.augmented for term in self.contacts)):
             raise NotImplementedError("a GLS kind (augmented Newton step) must be the only "
                                       "contact term of a problem")
-        fc = form_compiler_params or {}
-        jit = jit_params or {}
-        self.L = fem.form(F, form_compiler_params=fc, jit_params=jit)
+        fc = form_compiler_options or {}
+        jit = jit_options or {}
+        self.L = fem.form(F, form_compiler_options=fc, jit_options=jit)
         if J is None:
             J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
-        self.a = fem.form(J, form_compiler_params=fc, jit_params=jit)
+        self.a = fem.form(J, form_compiler_options=fc, jit_options=jit)
         self._A: Optional[PETSc.Mat] = None
         self._b: Optional[PETSc.Vec] = None
         self._near_nullspace: Optional[PETSc.NullSpace] = None
@@ -113,9 +129,9 @@ class NonlinearContactProblem:
     def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
         """Assemble the residual at ``x`` into ``b`` (the contact states are updated)."""
         clock = time.perf_counter()
-        if x.handle != self.u.vector.handle:
-            x.copy(self.u.vector)
-        self.u.vector.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        if x.handle != self.u.x.petsc_vec.handle:
+            x.copy(self.u.x.petsc_vec)
+        self.u.x.petsc_vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         if self._take_offer(x, b):
             # the contact states are those of the offer's evaluation, at this x
             return
@@ -126,12 +142,12 @@ class NonlinearContactProblem:
         # entries, and a stale prescribed value on a ghost dof next to the
         # partition boundary acts as a spurious force (a block pressed by u_y
         # on a face the partition crosses gave 0.2% … 8× wrong forces)
-        fem_petsc.apply_lifting(b, [self.a], [self.bcs], x0=[self.u.vector], scale=-1.0)
+        fem_petsc.apply_lifting(b, [self.a], [self.bcs], x0=[self.u.x.petsc_vec], alpha=-1.0)
         b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         self._add("bulk_residual", clock)
         for term in self.contacts:
             term.assemble_residual(b, self.bcs)
-        fem_petsc.set_bc(b, self.bcs, self.u.vector, -1.0)
+        fem_petsc.set_bc(b, self.bcs, self.u.x.petsc_vec, -1.0)
 
     def J(self, x: PETSc.Vec, A: PETSc.Mat) -> None:
         """Assemble the Jacobian at the state of the last :meth:`F` into ``A``.
@@ -198,8 +214,50 @@ class NonlinearContactProblem:
     def vector(self) -> PETSc.Vec:
         """A residual vector."""
         if self._b is None:
-            self._b = fem_petsc.create_vector(self.L)
+            V = self.u.function_space
+            self._b = ghosted_vector(V.dofmap.index_map, V.dofmap.index_map_bs)
         return self._b
+
+    # -- the problem's own SNES, as dolfinx.fem.petsc.NonlinearProblem (0.10+) --------
+    @property
+    def solver(self) -> PETSc.SNES:
+        """The problem's SNES (Newton with the library's defaults, under
+        :attr:`petsc_options_prefix`), made on first use."""
+        if self._snes is None:
+            snes = PETSc.SNES().create(self.u.function_space.mesh.comm)
+            snes.setOptionsPrefix(self.petsc_options_prefix)
+            self.configure_snes(snes)
+            db = PETSc.Options()
+            options = {key: value for key, value in DEFAULT_OPTIONS.items()
+                       if not db.hasName(self.petsc_options_prefix + key)}
+            options.update(self.petsc_options)
+            with TemporaryOptions(self.petsc_options_prefix, options):
+                snes.setFromOptions()
+                self.configure_ksp(snes.getKSP())
+            self._snes = snes
+        return self._snes
+
+    def solve(self) -> fem.Function:
+        """Solve ``F(u) + R_c(u) = 0`` by Newton from the present ``u``, at the
+        present loads, and return ``u``.
+
+        As with DOLFINx's ``NonlinearProblem.solve``, check
+        ``problem.solver.getConvergedReason() > 0`` (or pass
+        ``"snes_error_if_not_converged": True``); a load path with cut-back
+        on failure is :class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`.
+        """
+        x = self.u.x.petsc_vec.copy()
+        try:
+            self.solver.solve(None, x)
+            x.copy(self.u.x.petsc_vec)
+        finally:
+            x.destroy()
+        self.u.x.scatter_forward()
+        return self.u
+
+    def __del__(self):
+        if self._snes is not None:
+            self._snes.destroy()
 
     # -- PETSc SNES --------------------------------------------------------------------
     def configure_ksp(self, ksp: PETSc.KSP) -> None:
@@ -233,7 +291,7 @@ def reaction_force(problem: NonlinearContactProblem, facet_tags, tag: int) -> np
     facets = facet_tags.find(tag)
     if mesh.comm.allreduce(len(facets)) == 0:
         raise ValueError(f"facet tag {tag} marks no facets")
-    b = fem_petsc.create_vector(problem.L)
+    b = problem.vector().duplicate()
     with b.localForm() as local:
         local.set(0.0)
     u.x.scatter_forward()

@@ -1,6 +1,6 @@
 """Slave surfaces made of tagged facets of a DOLFINx mesh (DOLFINx 0.5.2 API).
 
-One of the few modules that call DOLFINx (DESIGN.md §6). The surface's
+One of the few modules that call DOLFINx (docs/DESIGN.md, §Dependencies). The surface's
 functions are the (block) dofs of a Lagrange function space, numbered and
 distributed as DOLFINx numbers them, so nodal contact quantities line up with
 the displacement's dofs without any renumbering.
@@ -13,6 +13,7 @@ import dolfinx
 import numpy as np
 from dolfinx import fem
 
+from dolfinx_mortar import dolfinx_compat
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import NodeLayout
 
@@ -22,7 +23,7 @@ _FACET_CELL = {"interval": "point", "triangle": "interval",
 
 
 def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
-                  facet_tags: dolfinx.mesh.MeshTagsMetaClass, tag: int,
+                  facet_tags: dolfinx.mesh.MeshTags, tag: int,
                   quadratic_transform: bool = False,
                   axisymmetric: bool = False) -> LagrangeSurface:
     """The surface of the facets marked ``tag``, owned by this rank.
@@ -54,12 +55,12 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     """
     if isinstance(space, dolfinx.mesh.Mesh):
         mesh = space
-        degree = mesh.geometry.cmap.degree
-        space = fem.FunctionSpace(mesh, ("Lagrange", degree))
+        degree = dolfinx_compat.coordinate_element(mesh).degree
+        space = fem.functionspace(mesh, ("Lagrange", degree))
     mesh = space.mesh
     element = space.ufl_element()
-    degree = element.degree()
-    family = element.family()
+    degree = element.degree
+    family = element.family_name
     if family not in ("Lagrange", "Q", "P") or degree not in (1, 2):
         raise ValueError(f"slave surfaces need a Lagrange space of degree 1 or 2, "
                          f"got {family} of degree {degree}")
@@ -93,7 +94,7 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     dof_layout = space.dofmap.dof_layout
     closure = np.array([dof_layout.entity_closure_dofs(fdim, i)
                         for i in range(num_facets_per_cell)], dtype=np.int64)
-    cell_dofs = space.dofmap.list.array.reshape(-1, dof_layout.num_dofs)
+    cell_dofs = space.dofmap.list.reshape(-1, dof_layout.num_dofs)
     cells = cell_dofs[cell_of_facet[:, None], closure[local_facet]]
 
     index_map = space.dofmap.index_map
@@ -107,7 +108,7 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     if len(cells) == 0:
         return surface
     # Outward: the facet normal must point away from its cell's centroid.
-    geometry_dofs = mesh.geometry.dofmap.array.reshape(len(cell_dofs), -1)
+    geometry_dofs = dolfinx_compat.geometry_dofmap(mesh)
     cell_centres = mesh.geometry.x[geometry_dofs[cell_of_facet], :gdim].mean(axis=1)
     facet_centres = x[cells].mean(axis=1)
     normals = surface.cell_normals().mean(axis=1)

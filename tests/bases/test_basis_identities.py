@@ -1,4 +1,4 @@
-"""The identities of DESIGN.md §2 for every kind on B-spline, NURBS and Lagrange
+"""The identities of docs/DESIGN.md, §Bases, for every kind on B-spline, NURBS and Lagrange
 slave surfaces, and on axisymmetric (r, z) lines, where every integral carries
 2πr (docs/AXISYMMETRIC.md): the identities hold for the weighted measure.
 
@@ -49,9 +49,9 @@ SURFACES = {
     "nurbs-surface-p2": lambda: nurbs.BSplineSurface(degree=2, n_elements=(3, 4)),
     "nurbs-surface-p12-rational-curved": lambda: nurbs.BSplineSurface(
         degree=(1, 2), n_elements=(3, 3), weights=_rng_weights((4, 5)),
-        control_points=np.stack(np.meshgrid(np.linspace(0, 1, 4), np.linspace(0, 1, 5),
-                                            indexing="ij") + [
-            0.2 * np.random.default_rng(5).uniform(size=(4, 5))], axis=-1)),
+        control_points=np.stack([*np.meshgrid(np.linspace(0, 1, 4), np.linspace(0, 1, 5),
+                                              indexing="ij"),
+                                 0.2 * np.random.default_rng(5).uniform(size=(4, 5))], axis=-1)),
     "P1-line": lambda: curved_line(1),
     "P2-line": lambda: curved_line(2),
     "P1-line-axisymmetric": lambda: curved_line(1, axisymmetric=True),

@@ -31,7 +31,7 @@ def two_cylinders(orientation: str, degree: int = 1):
     fine, coarse = 0.09, 0.14
     h_lower, h_upper = (fine, coarse) if orientation == "finer-slave" else (coarse, fine)
     domain, tags = demo.build_mesh(2, h_lower, h_upper, degree, MPI.COMM_WORLD)
-    return demo, fem.VectorFunctionSpace(domain, ("Lagrange", degree)), tags, fine
+    return demo, fem.functionspace(domain, ("Lagrange", degree, (domain.geometry.dim,))), tags, fine
 
 
 def deviation_from(problem, p: float) -> float:
@@ -120,7 +120,7 @@ def pressed_cylinder(obstacle, kind: str, depth: float, active_set: str = "nodal
     problem.set_load(1.0)
     problem.u.interpolate(lambda x: np.vstack([0.001 * x[0] * x[1],
                                                -depth + 0.003 * x[0] ** 2]))
-    fem.petsc.set_bc(problem.u.vector, problem.bcs)
+    fem.petsc.set_bc(problem.u.x.petsc_vec, problem.bcs)
     problem.u.x.scatter_forward()
     assert has_gaps_of_both_signs(problem)
     return problem
@@ -163,8 +163,8 @@ def test_jacobian_matches_finite_differences_between_two_bodies(kind, active_set
     cells = np.arange(domain.topology.index_map(2).size_local, dtype=np.int32)
     upper = cells[mesh.compute_midpoints(domain, 2, cells)[:, 1] > 0]
     problem.u.interpolate(lambda x: np.vstack([0.002 * x[0], 0.004 * (0.5 - x[0]) + 0.0013]),
-                          cells=upper)
-    fem.petsc.set_bc(problem.u.vector, problem.bcs)
+                          cells0=upper)
+    fem.petsc.set_bc(problem.u.x.petsc_vec, problem.bcs)
     problem.u.x.scatter_forward()
     assert has_gaps_of_both_signs(problem)
     assert jacobian_error(problem) < 1e-7
@@ -211,7 +211,7 @@ def test_bad_axisymmetric_input_is_named():
     # the mesh on the wrong side of the axis
     domain, tags_left = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (4, 2), bottom=1, top=2, left=3)
     domain.geometry.x[:, 0] -= 0.5
-    V_left = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V_left = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     with pytest.raises(ValueError, match="r ≥ 0"):
         ContactTerm(fem.Function(V_left), tags_left, BOTTOM, obstacle=plane, penalty=1.0,
                     axisymmetric=True)
@@ -229,7 +229,7 @@ def test_separated_bodies_feel_no_contact_force():
     domain = V.mesh
     cells = np.arange(domain.topology.index_map(2).size_local, dtype=np.int32)
     upper = cells[mesh.compute_midpoints(domain, 2, cells)[:, 1] > 0]
-    u.interpolate(lambda x: np.vstack([0.01 * x[0], np.full(x.shape[1], 1e-4)]), cells=upper)
+    u.interpolate(lambda x: np.vstack([0.01 * x[0], np.full(x.shape[1], 1e-4)]), cells0=upper)
     u.x.scatter_forward()
     contact = ContactTerm(u, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, kind="LcLS*",
                           penalty=1e3 / fine, axisymmetric=True)

@@ -18,7 +18,7 @@ def overhanging_blocks(comm=MPI.COMM_WORLD):
     facets (lower top). Tags: 1 slave, 2 master, 3 lower bottom, 4 upper top,
     5 upper left."""
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     gmsh.initialize(["", "-v", "0"])
     try:
         if comm.rank == 0:
@@ -47,10 +47,10 @@ def overhanging_blocks(comm=MPI.COMM_WORLD):
             gmsh.model.mesh.setSize(gmsh.model.getBoundary([(2, lower)], recursive=True), 0.09)
             gmsh.model.mesh.setSize(gmsh.model.getBoundary([(2, upper)], recursive=True), 0.13)
             gmsh.model.mesh.generate(2)
-        domain, _, tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+        domain, _, tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
     finally:
         gmsh.finalize()
-    return fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags
+    return fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,))), tags
 
 
 def _problem(V, tags, kind, modification):
@@ -118,13 +118,13 @@ def test_two_touching_cylinders_see_no_false_penetration_by_default(axisymmetric
     into a penetration. The default switches the modification on for the dual
     kinds against an elastic master; off, the false penetration is there."""
     from dolfinx_mortar import ContactTerm
-    from dolfinx_mortar.demo_support.hertz_meshes import MASTER, SLAVE, quarter_disk_mesh
+    from demo_support.hertz_meshes import MASTER, SLAVE, quarter_disk_mesh
     from support import load_demo
     demo = load_demo("hertz_axisymmetric")    # its two-sphere mesh at the default size
     a = demo.hertz(demo.parse_args(["--obstacle", "sphere"]))["a"]
     h = a / 40
     domain, tags = quarter_disk_mesh(1.0, a, h, "disk", 1, MPI.COMM_WORLD)
-    u = fem.Function(fem.VectorFunctionSpace(domain, ("Lagrange", 1)))
+    u = fem.Function(fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,))))
 
     def largest_gap(**options) -> float:
         contact = ContactTerm(u, tags, SLAVE, master_tag=MASTER, kind="LcLS*", penalty=1e3,

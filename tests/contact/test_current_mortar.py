@@ -126,7 +126,7 @@ def test_current_mortar_newton_converges_quadratically():
     demo = load_demo("hertz2d")
     args = demo.parse_args(["--refine", "0.4", "--obstacle", "elastic"])
     domain, tags, h = demo.build_mesh(args, demo.hertz(args)["a"], MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     previous = _hertz2d_elastic(demo, V, tags, h, "previous", 0.02)
     previous.solve(load_steps=8)
     current = _hertz2d_elastic(demo, V, tags, h, "current", 0.02)

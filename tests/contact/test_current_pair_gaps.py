@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.demo_support.pair_scenes import FT, MASTER_ID_OFFSET, PairScene, gathered
+from demo_support.pair_scenes import FT, MASTER_ID_OFFSET, PairScene, gathered
 
 
 def _moved(case, node_id: int, k: int, h: float):

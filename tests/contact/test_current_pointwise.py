@@ -19,7 +19,7 @@ POINTWISE_KINDS = ("LmLS", "LmLS*")
 
 def _residual(problem: ContactProblem) -> np.ndarray:
     b = problem.problem.vector().duplicate()
-    problem.problem.F(problem.u.vector, b)
+    problem.problem.F(problem.u.x.petsc_vec, b)
     return b.array.copy()
 
 
@@ -81,8 +81,8 @@ def test_current_pointwise_is_the_nodal_model_where_everything_penetrates(kind):
     assert comm.allreduce(float(np.max(np.abs(r_p - r_n))), op=MPI.MAX) <= 1e-12 * scale
     J_p, J_n = pointwise.problem.matrix(), nodal.problem.matrix()
     for problem, J in ((pointwise, J_p), (nodal, J_n)):
-        problem.problem.J(problem.u.vector, J)
-        problem.problem.J(problem.u.vector, J)      # the active set settled: geometric
+        problem.problem.J(problem.u.x.petsc_vec, J)
+        problem.problem.J(problem.u.x.petsc_vec, J)      # the active set settled: geometric
     J_p.axpy(-1.0, J_n)
     assert J_p.norm() <= 1e-12 * J_n.norm()
 

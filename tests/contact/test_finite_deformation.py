@@ -53,7 +53,7 @@ def test_current_residual_is_the_gradient_and_the_jacobian_is_exact(kind, scalin
 
 def test_current_jacobian_is_exact_on_curved_p2_facets():
     domain = mesh.create_rectangle(MPI.COMM_WORLD, [[0, 0], [1, 0.5]], [6, 3])
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 2))
+    V = fem.functionspace(domain, ("Lagrange", 2, (domain.geometry.dim,)))
     _, tags = block_on_plane(n=(6, 3))
     tags = mesh.meshtags(domain, 1, tags.indices, tags.values)
     problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, -2.0], 2.01), E=1.0,
@@ -78,7 +78,7 @@ def test_current_jacobian_is_exact_in_3d():
         values.append(np.full(len(f), tag, dtype=np.int32))
     facets, unique = np.unique(np.concatenate(facets), return_index=True)
     tags = mesh.meshtags(domain, 2, facets.astype(np.int32), np.concatenate(values)[unique])
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     for kind in ("LcLS*", "LmLS"):
         problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, 0.5, -2.0], 2.01),
                                  E=1.0, nu=0.3, kind=kind, penalty=50.0,
@@ -96,7 +96,7 @@ def _hertz2d_mesh(refine: str = "0.4"):
     demo = load_demo("hertz2d")
     args = demo.parse_args(["--refine", refine])
     domain, tags, h = demo.build_mesh(args, demo.hertz(args)["a"], MPI.COMM_WORLD)
-    return demo, fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags, h
+    return demo, fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,))), tags, h
 
 
 def _hertz2d_problem(mesh_data, configuration: str, traction: float) -> ContactProblem:
@@ -153,13 +153,13 @@ def test_current_configuration_reports_what_it_cannot_do():
         cube_tags = mesh.meshtags(cube, 2, np.concatenate(faces)[order].astype(np.int32),
                                   np.concatenate([np.full(len(f), t, dtype=np.int32)
                                                   for f, t in zip(faces, (1, 2))])[order])
-        V3 = fem.VectorFunctionSpace(cube, ("Lagrange", degree))
+        V3 = fem.functionspace(cube, ("Lagrange", degree, (cube.geometry.dim,)))
         with pytest.raises(NotImplementedError, match=message):
             ContactProblem(V3, cube_tags, 1, master_tag=2, kind="LcLS*", **common)
     with pytest.raises(NotImplementedError, match="boundary modification"):
         ContactProblem(V, tags, 1, master_tag=2, kind="LcLS*", boundary_modification=True,
                        **common)
-    V2 = fem.VectorFunctionSpace(V.mesh, ("Lagrange", 2))
+    V2 = fem.functionspace(V.mesh, ("Lagrange", 2, (V.mesh.geometry.dim,)))
     with pytest.raises(NotImplementedError, match="P1 lines or triangles"):
         ContactProblem(V2, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), kind="LcLS*",
                        **common)

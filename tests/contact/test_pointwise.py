@@ -62,7 +62,7 @@ def test_pointwise_jacobian_matches_finite_differences_on_cut_cells(kind, obstac
 def test_pointwise_jacobian_matches_finite_differences_elastic_master():
     demo = load_demo("patch_test")
     domain, tags = demo.build_mesh(2, 0.09, 0.14, 1, MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
                              nu=0.3, kind="LmLS*", penalty=1e3, active_set="pointwise",
                              fixed={demo.SYM_X: {0: 0.0}, demo.BOTTOM: {1: 0.0}},
@@ -72,7 +72,7 @@ def test_pointwise_jacobian_matches_finite_differences_elastic_master():
     tdim = domain.topology.dim
     cells = np.arange(domain.topology.index_map(tdim).size_local, dtype=np.int32)
     upper = cells[mesh.compute_midpoints(domain, tdim, cells)[:, 1] > 0]
-    problem.u.interpolate(lambda x: np.vstack([0 * x[0], -0.002 * (x[0] - 0.4)]), cells=upper)
+    problem.u.interpolate(lambda x: np.vstack([0 * x[0], -0.002 * (x[0] - 0.4)]), cells0=upper)
     problem.u.x.scatter_forward()
     state = problem.contact.evaluate()
     n = problem.slave.layout.num_owned

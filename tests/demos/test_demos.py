@@ -49,7 +49,7 @@ def test_demo_command_lines_pass_petsc_options_to_the_database():
 
     from petsc4py import PETSc
 
-    from dolfinx_mortar.demo_support.cli import parse_args_and_petsc_options
+    from demo_support.cli import parse_args_and_petsc_options
     parser = argparse.ArgumentParser()
     parser.add_argument("--refine", type=float, default=1.0)
     args = parse_args_and_petsc_options(parser, ["--refine", "2", "-cli_test_snes_monitor",

@@ -3,7 +3,7 @@ exact profile, and not swung by one outlying node."""
 import numpy as np
 import pytest
 
-from dolfinx_mortar.demo_support.hertz_fit import fit_hertz_profile, hertz_profile
+from demo_support.hertz_fit import fit_hertz_profile, hertz_profile
 
 A, P0 = 0.3, 2.0
 

@@ -20,7 +20,7 @@ from dolfinx_mortar import ContactProblem  # noqa: E402
 
 output, steps = sys.argv[1], int(sys.argv[2])
 domain, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (8, 4), bottom=1, top=2, left=3)
-V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
 problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
                          kind="LcLS*", penalty=1e4, fixed={3: {0: 0.0}},
                          tractions={2: [0.0, -0.01]})

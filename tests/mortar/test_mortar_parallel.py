@@ -36,7 +36,7 @@ def two_blocks(comm, dim, degree):
                                                lambda x: np.isclose(x[dim - 1], where))
         tags = mesh.meshtags(domain, fdim, np.sort(facets).astype(np.int32),
                              np.full(len(facets), tag, dtype=np.int32))
-        V = fem.VectorFunctionSpace(domain, ("Lagrange", degree))
+        V = fem.functionspace(domain, ("Lagrange", degree, (domain.geometry.dim,)))
         out.append((V, tags))
     return out
 
@@ -126,7 +126,7 @@ def one_mesh_two_bodies(comm):
     lower [0,1]x[-0.5,0] (slave on top, h=0.1), upper [0.2,1.3]x[0,0.4] (master at
     the bottom, h=0.17)."""
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     gmsh.initialize(["", "-v", "0"])
     try:
         if comm.rank == 0:
@@ -144,7 +144,7 @@ def one_mesh_two_bodies(comm):
                 points = gmsh.model.getBoundary([(2, surface)], recursive=True)
                 gmsh.model.mesh.setSize(points, h)
             gmsh.model.mesh.generate(2)
-        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+        domain, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
     finally:
         gmsh.finalize()
     return domain, facet_tags
@@ -154,7 +154,7 @@ def test_one_mesh_with_two_bodies():
     results = []
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
         domain, tags = one_mesh_two_bodies(comm)
-        V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+        V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
         slave, master = facet_surface(V, tags, SLAVE), facet_surface(V, tags, MASTER)
         c = MortarCoupling(slave, master)
         assert c.total_covered_area == pytest.approx(0.8, rel=1e-12)

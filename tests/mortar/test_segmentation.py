@@ -1,4 +1,4 @@
-"""Segmentation and mortar integrals on non-matching flat surfaces (DESIGN.md §3–§4)."""
+"""Segmentation and mortar integrals on non-matching flat surfaces (docs/DESIGN.md, §Segmentation)."""
 from __future__ import annotations
 
 import numpy as np

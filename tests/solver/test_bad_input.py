@@ -18,7 +18,7 @@ PLANE = RigidPlane([0, 0], [0, 1])
 def block(n=(8, 4)):
     """[0,1]x[0,0.5]; tags: 1 bottom (slave), 2 top (load), 3 left."""
     domain, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, n, bottom=1, top=2, left=3)
-    return fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags
+    return fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,))), tags
 
 
 def problem(V, tags, **overrides):
@@ -92,7 +92,7 @@ def test_tangled_cells_are_reported():
     x[inner, 0] += 0.4          # past its neighbours at x = 0.75: cells fold over
     _, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (4, 2), bottom=1, top=2, left=3)
     tags = mesh.meshtags(domain, 1, tags.indices, tags.values)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     with pytest.raises(ValueError, match="tangled cells"):
         problem(V, tags)
 
@@ -104,6 +104,6 @@ def test_collapsed_cell_is_reported():
     x[np.isclose(x[:, 0], 0.25) & np.isclose(x[:, 1], 0.0), 0] = 0.0
     _, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (4, 2), bottom=1, top=2, left=3)
     tags = mesh.meshtags(domain, 1, tags.indices, tags.values)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     with pytest.raises(ValueError, match="zero size|degenerate facet"):
         problem(V, tags)

@@ -138,7 +138,7 @@ def pressed_block(configuration: str = "current"):
     """A neo-Hookean block pressed by its top face onto a rigid disk."""
     domain, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (12, 6), bottom=BOTTOM, top=TOP,
                              left=LEFT)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     u = fem.Function(V)
     F = load_demo("press_and_slide").neo_hookean_residual(u, 1.0, 0.3)
     contact = CountingContactTerm(u, tags, BOTTOM, obstacle=RigidSphere([0.5, -2.0], 2.0),
@@ -157,8 +157,8 @@ def test_an_offered_residual_is_used_once_and_only_at_its_point():
     push.value = -0.01
     u = problem.u
     u.interpolate(lambda x: np.vstack([0.01 * x[1], -0.002 - 0.02 * x[1]]))
-    fem.petsc.set_bc(u.vector, problem.bcs)
-    x = u.vector.copy()
+    fem.petsc.set_bc(u.x.petsc_vec, problem.bcs)
+    x = u.x.petsc_vec.copy()
     fresh, b = problem.vector().duplicate(), problem.vector().duplicate()
     problem.F(x, fresh)
     before = contact.evaluations
@@ -191,7 +191,7 @@ def test_current_surface_steps_cost_one_residual_when_taken_whole():
     problem, contact, push = pressed_block()
     start = LoadPathSolver(problem)
     start.solve(lambda t: setattr(push, "value", -0.02 * t), load_steps=2)
-    x0 = problem.u.vector.copy()
+    x0 = problem.u.x.petsc_vec.copy()
     push.value = -0.025
     solutions, counts = [], []
     for options in ({}, {"snes_linesearch_type": "l2"}):

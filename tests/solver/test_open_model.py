@@ -33,7 +33,7 @@ E_PLANE = E / (1 - NU ** 2)   # plane strain, free sideways
 
 def block(n=(8, 4), degree=1):
     domain, tags = rectangle(MPI.COMM_WORLD, 0.0, H, n, bottom=BOTTOM, top=TOP, left=LEFT)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", degree))
+    V = fem.functionspace(domain, ("Lagrange", degree, (domain.geometry.dim,)))
     return domain, tags, V
 
 
@@ -44,7 +44,7 @@ def dirichlet(V, tags, tag, component, value):
 
 def jacobian_error(problem: NonlinearContactProblem, seed: int = 3) -> float:
     """Central differences of problem.F against problem.J at the present u."""
-    x0 = problem.u.vector.copy()
+    x0 = problem.u.x.petsc_vec.copy()
     A = problem.matrix()
     b = problem.vector().duplicate()
     problem.F(x0, b)
@@ -52,7 +52,7 @@ def jacobian_error(problem: NonlinearContactProblem, seed: int = 3) -> float:
     problem.J(x0, A)   # "current": exact once the active set is the previous call's
     dx = x0.duplicate()
     dx.array[:] = np.random.default_rng(seed + MPI.COMM_WORLD.rank).normal(size=dx.array.shape)
-    fem.petsc.set_bc(dx, problem.bcs, scale=0.0)
+    fem.petsc.set_bc(dx, problem.bcs, alpha=0.0)
     Jdx = b.duplicate()
     A.mult(dx, Jdx)
     h = 1e-6 / dx.norm()
@@ -66,7 +66,7 @@ def jacobian_error(problem: NonlinearContactProblem, seed: int = 3) -> float:
     fd = residuals[0] - residuals[1]
     fd.scale(1 / (2 * h))
     fd.axpy(-1.0, Jdx)
-    x0.copy(problem.u.vector)
+    x0.copy(problem.u.x.petsc_vec)
     problem.u.x.scatter_forward()
     return fd.norm() / Jdx.norm()
 
@@ -89,7 +89,7 @@ def test_neo_hookean_user_form_has_the_exact_jacobian(kind, configuration):
                                        -0.004 + 0.004 * x[0] ** 2 - 0.02 * x[1]]))
     # a state that meets the BCs, as Newton's iterates do (DOLFINx's lifting
     # of a nonlinear form is only differentiated there)
-    fem.petsc.set_bc(u.vector, bcs)
+    fem.petsc.set_bc(u.x.petsc_vec, bcs)
     u.x.scatter_forward()
     p = contact.nodal_pressures()
     n = contact.slave.layout.num_owned
@@ -188,7 +188,7 @@ def test_initial_configuration_warns_past_an_element_of_slip(configuration):
     "initial" segmentation is warned about, the rebuilt "previous" one is not."""
     demo = load_demo("patch_test")
     domain, tags = demo.build_mesh(2, 0.09, 0.14, 1, MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
                              nu=0.3, kind="LcLS*", penalty=1e3,
                              basis_configuration=configuration,
@@ -273,7 +273,7 @@ def test_repeated_evaluations_do_not_pile_up_petsc_objects(configuration, capfd)
     bcs = [dirichlet(V, tags, LEFT, 0, 0.0), dirichlet(V, tags, TOP, 1, 0.0)]
     problem = NonlinearContactProblem(linear_elastic_residual(u, E, NU), u, contact, bcs)
     u.interpolate(lambda x: np.vstack([0.0 * x[0], -0.01 + 0.002 * x[0]]))
-    x, A, b = u.vector.copy(), problem.matrix(), problem.vector().duplicate()
+    x, A, b = u.x.petsc_vec.copy(), problem.matrix(), problem.vector().duplicate()
 
     def evaluate() -> None:
         problem.F(x, b)

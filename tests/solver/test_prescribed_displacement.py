@@ -45,7 +45,7 @@ def slave_pressures(problem: ContactProblem) -> np.ndarray:
 def block_pressed_on_plane(comm, kind: str, penalty: float) -> ContactProblem:
     """[0,1]×[0,0.5] on the plane y = 0, top face moved down by PUSH."""
     domain, tags = rectangle(comm, 0.0, 0.5, (8, 4), bottom=BOTTOM, top=TOP, left=LEFT)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, BOTTOM, obstacle=RigidPlane([0, 0], [0, 1]), E=E, nu=NU,
                              kind=kind, penalty=penalty,
                              fixed={LEFT: {0: 0.0}, TOP: {1: -PUSH}})
@@ -56,7 +56,7 @@ def block_pressed_on_plane(comm, kind: str, penalty: float) -> ContactProblem:
 def disk_pressed_into_block(comm, kind: str) -> ContactProblem:
     """A rigid disk resting on [0,1]×[-0.5,0]; the bottom face moved up by PUSH."""
     domain, tags = rectangle(comm, -0.5, 0.0, (12, 6), bottom=BOTTOM, top=TOP, left=LEFT)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, TOP, obstacle=RigidSphere([0.0, 1.0], 1.0), E=E, nu=NU,
                              kind=kind, penalty=1e3, fixed={LEFT: {0: 0.0}, BOTTOM: {1: PUSH}})
     problem.facet_tags = tags

@@ -61,7 +61,7 @@ def test_two_materials_in_one_form_reproduce_the_piecewise_linear_solution(kind)
     owned_cells = np.arange(domain.topology.index_map(2).size_local, dtype=np.int32)
     cell_tags = mesh.meshtags(domain, 2, owned_cells,
                              np.where(lower_cells[owned_cells], LOWER, UPPER).astype(np.int32))
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     u, v = fem.Function(V), ufl.TestFunction(V)
     dx = ufl.Measure("dx", domain=domain, subdomain_data=cell_tags)
     ds = ufl.Measure("ds", domain=domain, subdomain_data=facet_tags)
@@ -93,7 +93,7 @@ def test_two_materials_in_one_form_reproduce_the_piecewise_linear_solution(kind)
     nodes = V.tabulate_dof_coordinates()
     owned = V.dofmap.index_map.size_local
     lower = np.zeros(len(nodes), dtype=bool)
-    cell_nodes = V.dofmap.list.array.reshape(-1, 3)
+    cell_nodes = V.dofmap.list.reshape(-1, 3)
     lower[cell_nodes[lower_cells].ravel()] = True   # the blocks share no node
     exact = exact_displacement(nodes, lower, p, penalty)
     error = np.max(np.abs(u.x.array.reshape(-1, 2)[:owned] - exact[:owned]), initial=0.0)

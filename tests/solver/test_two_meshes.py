@@ -28,7 +28,7 @@ def gmsh_blocks(comm, blocks, degree=1):
     """One gmsh model with the given structured (transfinite) rectangles, each
     meshed independently: the same block gives the same mesh in any model."""
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     gmsh.initialize(["", "-v", "0"])
     try:
         if comm.rank == 0:
@@ -54,7 +54,7 @@ def gmsh_blocks(comm, blocks, degree=1):
             gmsh.model.mesh.generate(2)
             if degree == 2:
                 gmsh.model.mesh.setOrder(2)
-        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+        domain, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
     finally:
         gmsh.finalize()
     return domain, facet_tags
@@ -133,7 +133,7 @@ def test_merged_boxes_3d(cell_type):
 def test_quadratic_geometry_keeps_curved_facets():
     """P2 gmsh meshes (a disk and a block): lengths of curved tagged facets survive."""
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     comm = MPI.COMM_WORLD
     gmsh.initialize(["", "-v", "0"])
     try:
@@ -147,7 +147,7 @@ def test_quadratic_geometry_keeps_curved_facets():
             gmsh.option.setNumber("Mesh.MeshSizeMax", 0.1)
             gmsh.model.mesh.generate(2)
             gmsh.model.mesh.setOrder(2)
-        disk, _, disk_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+        disk, _, disk_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
     finally:
         gmsh.finalize()
     block, block_tags = gmsh_blocks(comm, [dict(LOWER, nx=4, ny=2)], degree=2)
@@ -211,7 +211,7 @@ def two_mesh_problem(comm, kind, separate=True, shear=0.0):
         return ContactProblem.from_two_meshes(a, tags_a, LOWER_TOP, b, tags_b, UPPER_BOTTOM,
                                               shared_tags=[LEFT], **common)
     domain, tags = gmsh_blocks(comm, [lower, upper])
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     return ContactProblem(V, tags, LOWER_TOP, master_tag=UPPER_BOTTOM, **common)
 
 

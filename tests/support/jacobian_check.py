@@ -13,10 +13,10 @@ from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 def random_direction(problem, rng_seed: int):
     """A random vector of the problem's space, zero on its Dirichlet dofs
     (each rank draws its own part)."""
-    v = problem.u.vector.duplicate()
+    v = problem.u.x.petsc_vec.duplicate()
     v.array[:] = np.random.default_rng(rng_seed + MPI.COMM_WORLD.rank).normal(
         size=v.array.shape)
-    fem.petsc.set_bc(v, problem.bcs, scale=0.0)
+    fem.petsc.set_bc(v, problem.bcs, alpha=0.0)
     return v
 
 
@@ -32,7 +32,7 @@ def has_gaps_of_both_signs(problem) -> bool:
 
 def jacobian_error(problem, rng_seed: int = 1) -> float:
     """‖(R(x + h dx) − R(x − h dx))/2h − J dx‖ / ‖J dx‖ at the current u."""
-    x0 = problem.u.vector.copy()
+    x0 = problem.u.x.petsc_vec.copy()
     J = problem.problem.matrix()
     b0 = problem.problem.vector().duplicate()
     problem.problem.F(x0, b0)
@@ -52,7 +52,7 @@ def newton_step_error(problem, rng_seed: int = 2) -> float:
     """‖R'(x)Δu − r‖/‖r‖ for the Newton step Δu the problem's own linear solve
     gives for a random r (the augmented system of the GLS kinds), R' by
     central differences, at the current u."""
-    x0 = problem.u.vector.copy()
+    x0 = problem.u.x.petsc_vec.copy()
     b0 = problem.problem.vector().duplicate()
     problem.problem.F(x0, b0)
     J = problem.problem.matrix()
@@ -89,12 +89,12 @@ def newton_history(start, problem, prefix: str) -> np.ndarray:
     """Residual norms of ``problem``'s Newton solve at full load, started from
     the solution of ``start`` (a problem on the same function space)."""
     problem.set_load(1.0)
-    start.u.vector.copy(problem.u.vector)
+    start.u.x.petsc_vec.copy(problem.u.x.petsc_vec)
     problem.u.x.scatter_forward()
     problem.solver.prefix = prefix
     with problem.solver.options():
         snes = problem.solver.create_snes()
-        x = problem.u.vector.copy()
+        x = problem.u.x.petsc_vec.copy()
         snes.setConvergenceHistory(reset=True)
         snes.solve(None, x)
         r = np.array(snes.getConvergenceHistory()[0])
@@ -113,19 +113,19 @@ def convergence_order(r: np.ndarray) -> float:
 def energy_gradient_error(problem) -> float:
     """|Π(u + h v) − Π(u − h v)|/2h against R_c·v: the residual is ∂Π/∂u."""
     model = problem.gap_model
-    x0 = problem.u.vector.copy()
+    x0 = problem.u.x.petsc_vec.copy()
     Rc = problem.contact.update(problem.bcs).residual
     v = x0.duplicate()
     v.array[:] = np.random.default_rng(5 + MPI.COMM_WORLD.rank).normal(size=v.array.shape)
-    fem.petsc.set_bc(v, problem.bcs, scale=0.0)
+    fem.petsc.set_bc(v, problem.bcs, alpha=0.0)
     h = 1e-6 / v.norm()
     energies = []
     for sign in (1, -1):
-        x0.copy(problem.u.vector)
-        problem.u.vector.axpy(sign * h, v)
+        x0.copy(problem.u.x.petsc_vec)
+        problem.u.x.petsc_vec.axpy(sign * h, v)
         problem.u.x.scatter_forward()
         energies.append(model.energy(nodal_displacement(problem.slave, problem.u)))
-    x0.copy(problem.u.vector)
+    x0.copy(problem.u.x.petsc_vec)
     problem.u.x.scatter_forward()
     exact = Rc.dot(v)
     return abs((energies[0] - energies[1]) / (2 * h) - exact) / abs(exact)

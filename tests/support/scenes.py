@@ -17,7 +17,7 @@ ALL_KINDS = ["GLS", "GLS*"] + LOCAL_KINDS
 def block_on_plane(comm=MPI.COMM_WORLD, n=(8, 4)):
     """[0,1]x[0,0.5]; tags: 1 bottom (slave), 2 top (load), 3 left (u_x = 0)."""
     domain, tags = rectangle(comm, 0.0, 0.5, n, bottom=1, top=2, left=3)
-    return fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags
+    return fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,))), tags
 
 
 def pressed_block(obstacle, kind: str, n=(6, 3), **options) -> ContactProblem:
@@ -40,7 +40,7 @@ def assert_same_hertz2d_figures_on_one_and_all_ranks(argv: list, make_problem) -
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
         ref = demo.hertz(args)
         domain, tags, h = demo.build_mesh(args, ref["a"], comm)
-        problem = make_problem(demo, fem.VectorFunctionSpace(domain, ("Lagrange", 1)), tags, h)
+        problem = make_problem(demo, fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,))), tags, h)
         problem.solve(load_steps=2)
         results.append(demo.contact_results(problem, ref))
     for key in ("p0", "a", "l2_error", "contact_force"):
@@ -58,7 +58,7 @@ def sheared_blocks(kind: str, scaling: str = "consistent", degree: int = 1,
     that two problems share dofs."""
     demo = load_demo("patch_test")
     domain, tags = mesh_and_tags or demo.build_mesh(2, 0.09, 0.14, degree, comm)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", degree))
+    V = fem.functionspace(domain, ("Lagrange", degree, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
                              nu=0.3, kind=kind, penalty=1e3, scaling=scaling,
                              basis_configuration="current", active_set=active_set,
@@ -71,9 +71,9 @@ def sheared_blocks(kind: str, scaling: str = "consistent", degree: int = 1,
     problem.u.interpolate(lambda x: np.vstack([0.01 * x[1] + 0.03 * x[0] ** 2,
                                                -0.002 * (x[0] - 0.4) + 0.004 * x[0] ** 2
                                                - push]),
-                          cells=cells[midpoints > 0])
+                          cells0=cells[midpoints > 0])
     problem.u.interpolate(lambda x: np.vstack([0.004 * x[0] ** 2, 0.003 * np.sin(3 * x[0])]),
-                          cells=cells[midpoints < 0])
+                          cells0=cells[midpoints < 0])
     problem.u.x.scatter_forward()
     return problem
 
@@ -84,7 +84,7 @@ def sheared_boxes(kind: str, scaling: str = "consistent",
     twisted and slid into each other."""
     demo = load_demo("patch_test")
     domain, tags = demo.build_mesh(3, 0.25, 0.35, 1, MPI.COMM_WORLD)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
                              nu=0.3, kind=kind, penalty=1e3, scaling=scaling,
                              basis_configuration="current", active_set=active_set,
@@ -97,9 +97,9 @@ def sheared_boxes(kind: str, scaling: str = "consistent",
     problem.u.interpolate(lambda x: np.vstack([0.01 * x[2] + 0.03 * x[0] ** 2,
                                                0.02 * x[0] * x[1],
                                                -0.002 * (x[0] - 0.4) + 0.004 * x[1] ** 2]),
-                          cells=cells[height > 0])
+                          cells0=cells[height > 0])
     problem.u.interpolate(lambda x: np.vstack([0.004 * x[0] ** 2, 0.003 * x[1] ** 2,
                                                0.003 * np.sin(3 * x[0]) * np.cos(2 * x[1])]),
-                          cells=cells[height < 0])
+                          cells0=cells[height < 0])
     problem.u.x.scatter_forward()
     return problem

@@ -42,7 +42,7 @@ def build(comm, cell_type, degree):
     facets = mesh.locate_entities_boundary(domain, fdim, lambda x: x[0] < 0.8)
     tags = mesh.meshtags(domain, fdim, np.sort(facets).astype(np.int32),
                          np.full(len(facets), SLAVE, dtype=np.int32))
-    V = fem.FunctionSpace(domain, ("Lagrange", degree))
+    V = fem.functionspace(domain, ("Lagrange", degree))
     return domain, tags, V
 
 
@@ -134,7 +134,7 @@ def test_facet_nodes_follow_the_reference_ordering():
 
 def test_mesh_argument_uses_geometry_degree_on_curved_gmsh_mesh():
     gmsh = pytest.importorskip("gmsh")
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     comm = MPI.COMM_WORLD
     gmsh.initialize(["", "-v", "0"])
     try:
@@ -148,7 +148,7 @@ def test_mesh_argument_uses_geometry_degree_on_curved_gmsh_mesh():
             gmsh.option.setNumber("Mesh.CharacteristicLengthMax", 0.3)
             gmsh.model.mesh.generate(2)
             gmsh.model.mesh.setOrder(2)
-        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+        domain, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
     finally:
         gmsh.finalize()
     surface = facet_surface(domain, facet_tags, SLAVE)

@@ -1,4 +1,4 @@
-"""Averaged nodal normals that a facet of vanishing size cannot tilt (DESIGN.md §3)."""
+"""Averaged nodal normals a vanishing facet cannot tilt (docs/DESIGN.md, §Penalty contact)."""
 from __future__ import annotations
 
 import numpy as np

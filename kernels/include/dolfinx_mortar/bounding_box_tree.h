@@ -13,8 +13,9 @@ namespace dolfinx_mortar
 /// Axis-aligned bounding-box tree over a set of boxes (3D; 2D boxes use z=0).
 ///
 /// DOLFINx has a BoundingBoxTree, but the kernels take plain arrays and never
-/// include DOLFINx headers (DESIGN.md §1), and the boxes here are of moving,
-/// enlarged surface facets rather than mesh entities; so the tree is our own.
+/// include DOLFINx headers (docs/DESIGN.md, §Layers), and the boxes here are
+/// of moving, enlarged surface facets rather than mesh entities; so the tree
+/// is our own.
 /// Built by median splits along the longest axis: O(n log n) to build,
 /// O(log n + k) per query with k hits.
 class BoundingBoxTree

@@ -58,9 +58,9 @@ facet_reference_nodes(FacetType type);
 /// Normal of each cell at each of its nodes, (cells, nodes, gdim): unit, or
 /// with @p size_weighted of length |J| at the node (the facet's length or
 /// twice its area on P1 cells). Summing the size-weighted ones per node and
-/// normalizing gives the averaged nodal normals of DESIGN.md §3, which a
-/// facet of vanishing size cannot tilt (unit normals gave a 1e-6 h facet at
-/// 45° the same say as its neighbour: 22° of tilt).
+/// normalizing gives the averaged nodal normals (docs/DESIGN.md, §Penalty
+/// contact), which a facet of vanishing size cannot tilt (unit normals gave a
+/// 1e-6 h facet at 45° the same say as its neighbour: 22° of tilt).
 std::vector<double>
 element_node_normals(const FacetSurface& s, bool size_weighted = false);
 

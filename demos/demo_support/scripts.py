@@ -9,8 +9,8 @@ import importlib.util
 from pathlib import Path
 from types import ModuleType
 
-#: the checkout's demos/ (the package is used from the checkout, see ``make install``)
-DEMOS = Path(__file__).resolve().parents[2] / "demos"
+#: the checkout's demos/ (this package sits in it, outside the installed library)
+DEMOS = Path(__file__).resolve().parents[1]
 
 
 def load_script(path: Path) -> ModuleType:

@@ -26,7 +26,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar import (ContactDivergenceError, ContactTerm, LoadPathSolver,
                             NonlinearContactProblem)
-from dolfinx_mortar.demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
+from demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
 from dolfinx_mortar.io.output import save_figure, write_csv, write_json
 
 #: facet tags
@@ -84,7 +84,7 @@ def build_mesh(args: argparse.Namespace, comm: MPI.Comm):
     """Slab and die in one mesh (gmsh on rank 0, distributed): returns the mesh,
     cell tags and facet tags."""
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     dim = args.dim
     centre_z = HEIGHT + RADIUS          # the die's axis: its lowest point touches the slab
     gmsh.initialize(["", "-v", "0"])
@@ -160,7 +160,7 @@ def build_mesh(args: argparse.Namespace, comm: MPI.Comm):
                            "MeshSizeFromCurvature"):
                 gmsh.option.setNumber(f"Mesh.{option}", 0)
             gmsh.model.mesh.generate(dim)
-        domain, cell_tags, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=dim)
+        domain, cell_tags, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=dim)
     finally:
         gmsh.finalize()
     return domain, cell_tags, facet_tags
@@ -200,10 +200,10 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     clock = time.perf_counter()
     dim = args.dim
     domain, cell_tags, facet_tags = build_mesh(args, comm)
-    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1))
+    V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     u = fem.Function(V, name="u")
     # Young's modulus per cell: slab and die
-    Q = fem.FunctionSpace(domain, ("DG", 0))
+    Q = fem.functionspace(domain, ("DG", 0))
     E = fem.Function(Q)
     E.x.array[:] = args.E
     E.x.array[cell_tags.find(DIE)] = E_DIE * args.E

@@ -41,7 +41,7 @@ def quarter_disk_mesh(radius: float, a: float, h_contact: float, lower: str, deg
     body's bottom).
     """
     import gmsh
-    from dolfinx.io import gmshio
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
     from dolfinx_mortar.io.gmsh_io import grade_towards_point
     if lower not in LOWER_BODIES:
         raise ValueError(f"lower body must be one of {LOWER_BODIES}, got {lower!r}")
@@ -86,7 +86,7 @@ def quarter_disk_mesh(radius: float, a: float, h_contact: float, lower: str, deg
             gmsh.model.mesh.generate(2)
             if degree == 2:
                 gmsh.model.mesh.setOrder(2)
-        domain, _, facet_tags = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=2)
+        domain, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
     finally:
         gmsh.finalize()
     return domain, facet_tags
