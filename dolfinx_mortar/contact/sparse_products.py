@@ -75,11 +75,19 @@ class PatternTrackingAdd:
     is a malloc inside PETSc, and each one reallocates the row storage: 2.3 s
     for one Jacobian of Hertz 3D at 30k dofs, ten times the bulk assembly.
     When ``K``'s pattern differs from the last one added (compared exactly,
-    on every rank), ``A`` is rebuilt once with the union pattern
-    (DIFFERENT_NONZERO_PATTERN: 0.03-0.1 s); otherwise ``K``'s entries are
-    already in ``A``. The rebuild keeps ``A``'s handle, so SNES and the KSP
-    keep using it; what PETSc's rebuild drops (the near-nullspace, the
-    permission to allocate new entries) is put back.
+    on every rank), ``A`` is rebuilt once with the union pattern; otherwise
+    ``K``'s entries are already in ``A``. The rebuild keeps ``A``'s handle, so
+    SNES and the KSP keep using it; what the rebuild drops (the
+    near-nullspace, the permission to allocate new entries) is put back.
+
+    The union is formed in a copy (MatAXPY with DIFFERENT_NONZERO_PATTERN)
+    and poured into ``A`` by a new preallocation. MatAXPY straight into ``A``
+    swaps its storage without raising its nonzero state (PETSc 3.22 and
+    3.25): a KSP that had factorized ``A`` then kept MUMPS's analysis of the
+    old pattern and solved a different matrix, silently (a 6×6 test: residual
+    3.3 instead of 1e-15) or with MUMPS reporting a singular matrix (the
+    current configuration against an elastic master). A new preallocation
+    raises the nonzero state, and the preconditioner is set up afresh.
     """
 
     def __init__(self) -> None:
@@ -95,7 +103,13 @@ class PatternTrackingAdd:
             A.axpy(1.0, K, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
             return
         nullspace = A.getNearNullSpace()
-        A.axpy(1.0, K, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        union = A.duplicate(copy=True)
+        union.axpy(1.0, K, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        indptr, indices, values = union.getValuesCSR()
+        union.destroy()
+        A.setPreallocationCSR((indptr, indices))
+        A.setValuesCSR(indptr, indices, values)
+        A.assemble()
         A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         if nullspace is not None and nullspace.handle:
             A.setNearNullSpace(nullspace)

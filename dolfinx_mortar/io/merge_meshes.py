@@ -67,7 +67,7 @@ def _owned_tagged_facets(domain, facet_tags):
                        dtype=np.int32)
     geometry = dolfinx_compat.geometry_dofmap(domain)
     f_to_c, c_to_f = topology.connectivity(fdim, tdim), topology.connectivity(tdim, fdim)
-    nodes = np.empty((len(facets), layout.num_entity_closure_dofs(fdim)), dtype=np.int32)
+    nodes = np.empty((len(facets), len(layout.entity_closure_dofs(fdim, 0))), dtype=np.int32)
     for row, f in enumerate(facets):
         c = f_to_c.links(f)[0]
         local = int(np.flatnonzero(c_to_f.links(c) == f)[0])

@@ -23,6 +23,10 @@ from typing import NamedTuple, Optional, Sequence
 from petsc4py import PETSc
 
 _SNES = PETSc.SNES.ConvergedReason
+#: a residual with NaN or Inf: PETSc 3.25 calls it DIVERGED_FUNCTION_NANORINF, 3.22 DIVERGED_FNORM_NAN
+DIVERGED_NAN = getattr(_SNES, "DIVERGED_FUNCTION_NANORINF", None)
+if DIVERGED_NAN is None:
+    DIVERGED_NAN = _SNES.DIVERGED_FNORM_NAN
 _KSP = PETSc.KSP.ConvergedReason
 
 
@@ -93,7 +97,7 @@ class EquilibriumTest:
         self.norms.append(fnorm)
         rtol, atol, stol, max_it = snes.getTolerances()
         if not math.isfinite(fnorm):
-            return _SNES.DIVERGED_FNORM_NAN
+            return DIVERGED_NAN
         if fnorm <= atol:
             return _SNES.CONVERGED_FNORM_ABS
         if fnorm <= rtol * self.reference:
@@ -159,7 +163,7 @@ def describe_failure(snes: PETSc.SNES, test: EquilibriumTest) -> str:
         return f"{name}: line search failed"
     if reason == _SNES.DIVERGED_MAX_IT:
         return f"{name}: maximum Newton iterations ({snes.getTolerances()[3]}) reached"
-    if reason == _SNES.DIVERGED_FNORM_NAN:
+    if reason == DIVERGED_NAN:
         return f"{name}: the residual is NaN or infinite"
     return name
 

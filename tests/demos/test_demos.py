@@ -74,7 +74,9 @@ def test_quickstart_runs_and_balances(tmp_path, monkeypatch):
     monkeypatch.chdir(workdir)
     scene = runpy.run_path(str(DEMOS / "quickstart.py"))
     force = scene["contact"].contact_force()
-    assert force[1] > 0 and abs(force[0]) < 1e-8 * force[1]
+    # frictionless on a symmetric scene: a horizontal force only from the
+    # mesh's asymmetry (1.0e-7 of the vertical one with gmsh 4.13's mesh)
+    assert force[1] > 0 and abs(force[0]) < 1e-6 * force[1]
     reaction = reaction_force(scene["problem"], scene["facet_tags"], scene["TOP"])
     assert reaction == pytest.approx(-force, rel=1e-8, abs=1e-10 * force[1])
 

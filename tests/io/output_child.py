@@ -14,6 +14,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/, for support
+sys.path.insert(1, str(Path(__file__).resolve().parents[2] / "demos"))  # demo_support
 from support.meshes import rectangle  # noqa: E402
 from dolfinx_mortar.contact.obstacles import RigidPlane  # noqa: E402
 from dolfinx_mortar import ContactProblem  # noqa: E402
