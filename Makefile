@@ -27,7 +27,7 @@ export OMPI_MCA_btl := self,sm
 export OMP_NUM_THREADS := 1
 # pytest with the installed package: -P keeps the checkout (the current directory) off
 # sys.path, so that `import dolfinx_mortar` is the installed package, with its kernels.
-PYTEST = $(PYTHON) -P -m pytest -q --color=no
+PYTEST = $(PYTHON_ABS) -P -m pytest -q --color=no
 
 DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 	python3-ffcx python3-petsc4py python3-mpi4py python3-gmsh pybind11-dev \

@@ -48,7 +48,7 @@ class TransposeProduct:
 
     def __init__(self) -> None:
         self._patterns: Optional[tuple] = None
-        self._product: Optional[PETSc.Mat] = None
+        self._mats: list[PETSc.Mat] = []     # A, B, Aᵀ, the product: the product's own
 
     def __call__(self, A: PETSc.Mat, B: PETSc.Mat) -> PETSc.Mat:
         patterns = (_pattern(A), _pattern(B))
@@ -56,15 +56,29 @@ class TransposeProduct:
                 and all(np.array_equal(new, old)
                         for pair_new, pair_old in zip(patterns, self._patterns)
                         for new, old in zip(pair_new, pair_old)))
+        # A product remembers the matrices it was made of, and PETSc reuses
+        # it only with those very objects (a new transpose each call left it
+        # pointing at a freed matrix: PETSc 3.22 crashed in parallel when it
+        # was destroyed). So it is made of copies kept here, refilled in place.
         if not A.getComm().tompi4py().allreduce(bool(same), op=MPI.LAND):
-            self._product = transpose_mat_mult(A, B)
+            self._destroy()
+            A_kept, B_kept = A.duplicate(copy=True), B.duplicate(copy=True)
+            At = PETSc.Mat()
+            A_kept.transpose(At)
+            self._mats = [A_kept, B_kept, At, At.matMult(B_kept)]
             self._patterns = patterns
-            return self._product
-        At = PETSc.Mat()
-        A.transpose(At)
-        At.matMult(B, result=self._product)
-        At.destroy()
-        return self._product
+            return self._mats[3]
+        A_kept, B_kept, At, product = self._mats
+        A.copy(A_kept, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        B.copy(B_kept, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        A_kept.transpose(At)
+        At.matMult(B_kept, result=product)
+        return product
+
+    def _destroy(self) -> None:
+        for M in self._mats:
+            M.destroy()
+        self._mats = []
 
 
 class PatternTrackingAdd:
@@ -80,40 +94,35 @@ class PatternTrackingAdd:
     SNES and the KSP keep using it; what the rebuild drops (the
     near-nullspace, the permission to allocate new entries) is put back.
 
-    The union is formed in a copy (MatAXPY with DIFFERENT_NONZERO_PATTERN)
-    and poured into ``A`` by a new preallocation. MatAXPY straight into ``A``
-    swaps its storage without raising its nonzero state (PETSc 3.22 and
-    3.25): a KSP that had factorized ``A`` then kept MUMPS's analysis of the
-    old pattern and solved a different matrix, silently (a 6×6 test: residual
-    3.3 instead of 1e-15) or with MUMPS reporting a singular matrix (the
-    current configuration against an elastic master). A new preallocation
-    raises the nonzero state, and the preconditioner is set up afresh.
+    The rebuild swaps ``A``'s storage (MatHeaderMerge) without raising its
+    nonzero state (PETSc 3.22 and 3.25), so a KSP that had factorized ``A``
+    keeps MUMPS's analysis of the old pattern and solves another matrix:
+    silently wrong (a residual of 4e7 on a 40×40 test), a MUMPS "singular"
+    error, or a crash in parallel. Pouring the union into ``A`` by a new
+    preallocation was right in serial but not on 2 ranks. So the call
+    returns whether the pattern changed, and the owner of the KSP resets its
+    preconditioner then (:meth:`NonlinearContactProblem.J`).
     """
 
     def __init__(self) -> None:
         self._rows: Optional[np.ndarray] = None
         self._cols: Optional[np.ndarray] = None
 
-    def __call__(self, A: PETSc.Mat, K: PETSc.Mat) -> None:
+    def __call__(self, A: PETSc.Mat, K: PETSc.Mat) -> bool:
         rows, cols, _ = K.getValuesCSR()
         same = (self._rows is not None and np.array_equal(rows, self._rows)
                 and np.array_equal(cols, self._cols))
         # MatAXPY is collective: every rank must take the same branch
         if A.getComm().tompi4py().allreduce(bool(same), op=MPI.LAND):
             A.axpy(1.0, K, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-            return
+            return False
         nullspace = A.getNearNullSpace()
-        union = A.duplicate(copy=True)
-        union.axpy(1.0, K, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        indptr, indices, values = union.getValuesCSR()
-        union.destroy()
-        A.setPreallocationCSR((indptr, indices))
-        A.setValuesCSR(indptr, indices, values)
-        A.assemble()
+        A.axpy(1.0, K, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         if nullspace is not None and nullspace.handle:
             A.setNearNullSpace(nullspace)
         self._rows, self._cols = rows.copy(), cols.copy()
+        return True
 
     def reset(self) -> None:
         """Forget the last pattern (the next add rebuilds ``A``'s pattern)."""

@@ -141,6 +141,9 @@ class ContactTerm(ContactResults):
         self._last_active: Optional[FloatArray] = None
         #: adds K to the Newton matrix when its pattern may change ("current")
         self._add_stiffness = PatternTrackingAdd()
+        #: whether the last :meth:`assemble_jacobian` changed the matrix's
+        #: nonzero pattern in a way PETSc does not see (the KSP must be reset)
+        self.pattern_changed = False
         self._augmented: Optional[AugmentedNewtonStep] = None
         self._built_at: Optional[FloatArray] = None
         #: global indices of this rank's rows that the last contact Jacobian
@@ -254,6 +257,7 @@ class ContactTerm(ContactResults):
         clock = time.perf_counter()
         mask = self.mask(bcs)
         state = self.state
+        self.pattern_changed = False
         if self.model.augmented:
             if self._augmented is None:
                 self._augmented = AugmentedNewtonStep(self.mesh.comm, self.augmented_prefix)
@@ -275,7 +279,7 @@ class ContactTerm(ContactResults):
             K = self.model.jacobian(state, active, mask, geometric=settled)
             self.stiffened_rows = stiffened_rows(K, self.V.dofmap.index_map_bs)
             if self.basis_configuration == "current":
-                self._add_stiffness(A, K)
+                self.pattern_changed = self._add_stiffness(A, K)
             else:
                 A.axpy(1.0, K, structure=SUBSET)
             A.assemble()

@@ -210,7 +210,7 @@ class LoadPathSolver:
                     target = stepper.target()
                     update(target)
                     if any([term.begin_step() for term in self.contacts]):
-                        snes.setJacobian(lambda _s, x, A, P: self.problem.J(x, A),
+                        snes.setJacobian(lambda _s, x, A, P: self.problem.J(x, A, _s.getKSP()),
                                          self.problem.refresh_matrix())
                     saved = u.x.petsc_vec.copy()
                     clock = time.perf_counter()

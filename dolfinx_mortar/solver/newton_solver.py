@@ -43,7 +43,7 @@ class NewtonSolver(_Base):
         super().__init__(comm, problem)
         # not in place of the base class's own matrix: its __del__ destroys that one
         self._problem = problem
-        self.setJ(problem.J, problem.matrix())
+        self.setJ(lambda x, A: problem.J(x, A, self.krylov_solver), problem.matrix())
 
     @property
     def A(self):

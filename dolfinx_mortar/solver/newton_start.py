@@ -47,7 +47,7 @@ def close_gaps(problem: NonlinearContactProblem, ksp: PETSc.KSP, x: PETSc.Vec) -
     if all(p is None for p in pulls):
         return
     A = problem.matrix()
-    problem.J(x, A)
+    problem.J(x, A, ksp)
     rhs = b.copy()
     for pull in pulls:
         if pull is not None:

@@ -149,12 +149,15 @@ class NonlinearContactProblem:
             term.assemble_residual(b, self.bcs)
         fem_petsc.set_bc(b, self.bcs, self.u.x.petsc_vec, -1.0)
 
-    def J(self, x: PETSc.Vec, A: PETSc.Mat) -> None:
+    def J(self, x: PETSc.Vec, A: PETSc.Mat, ksp: Optional[PETSc.KSP] = None) -> None:
         """Assemble the Jacobian at the state of the last :meth:`F` into ``A``.
 
         A must hold the contact's pattern (:meth:`matrix`). GLS kinds: A gets
         the bulk only, and the KSP applies the exact step
-        (:meth:`configure_ksp`).
+        (:meth:`configure_ksp`). ``ksp``, the solver that will use ``A``, has
+        its preconditioner reset when the contact pairs changed ``A``'s
+        pattern in a way PETSc does not notice
+        (:class:`~dolfinx_mortar.contact.sparse_products.PatternTrackingAdd`).
         """
         clock = time.perf_counter()
         A.zeroEntries()
@@ -163,6 +166,9 @@ class NonlinearContactProblem:
         self._add("bulk_jacobian", clock)
         for term in self.contacts:
             term.assemble_jacobian(A, self.bcs)
+        if ksp is not None and any(term.pattern_changed for term in self.contacts):
+            # a new symbolic factorization (or preconditioner set-up) at the next solve
+            ksp.getPC().reset()
 
     def matrix(self) -> PETSc.Mat:
         """The Jacobian matrix with the bulk and contact patterns (made once;
@@ -269,7 +275,7 @@ class NonlinearContactProblem:
     def configure_snes(self, snes: PETSc.SNES) -> None:
         """Give ``snes`` the residual, the Jacobian and its matrix."""
         snes.setFunction(lambda _snes, x, b: self.F(x, b), self.vector())
-        snes.setJacobian(lambda _snes, x, A, P: self.J(x, A), self.matrix())
+        snes.setJacobian(lambda _snes, x, A, P: self.J(x, A, _snes.getKSP()), self.matrix())
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since

@@ -75,6 +75,48 @@ def test_new_entries_are_merged_once_and_the_near_nullspace_is_kept():
     A.assemble()
 
 
+def _lu(A: PETSc.Mat) -> PETSc.KSP:
+    ksp = PETSc.KSP().create(MPI.COMM_WORLD)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    return ksp
+
+
+def _relative_residual(ksp: PETSc.KSP, A: PETSc.Mat) -> float:
+    b = A.createVecLeft()
+    b.set(1.0)
+    x = b.duplicate()
+    ksp.solve(b, x)
+    r = b.duplicate()
+    A.mult(x, r)
+    r.axpy(-1.0, b)
+    return r.norm() / b.norm()
+
+
+def test_a_changed_pattern_is_reported_and_a_reset_solver_solves_the_new_matrix():
+    """The rebuild does not raise A's nonzero state, so a factorized KSP would
+    keep the analysis of the old pattern; the caller resets it when told."""
+    A = _laplacian()
+    for i in range(N):     # diagonally dominant, so that LU is well conditioned
+        if A.getOwnershipRange()[0] <= i < A.getOwnershipRange()[1]:
+            A.setValue(i, i, 3.0, addv=PETSc.InsertMode.ADD_VALUES)
+    A.assemble()
+    ksp = _lu(A)
+    assert _relative_residual(ksp, A) < 1e-12
+    add = PatternTrackingAdd()
+    K = _far_coupling(17, 0.05)
+    assert add(A, K)                   # a new pattern
+    A.assemble()
+    ksp.getPC().reset()
+    ksp.setOperators(A)
+    assert _relative_residual(ksp, A) < 1e-12
+    assert not add(A, K)               # the same pattern again: only values
+    A.assemble()
+    assert _relative_residual(ksp, A) < 1e-12
+
+
 def test_plain_subset_add_would_malloc():
     """What the check above guards against: the same K added with
     SUBSET_NONZERO_PATTERN allocates entry by entry."""
