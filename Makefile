@@ -168,4 +168,4 @@ shell-trixie shell-sid: shell-%:
 	  'export debian_chroot=$(DEV_ROOT)-$*; cd /root/dolfinx_mortar && exec bash -i'
 
 clean:
-	rm -rf $(BUILD_DIR) build $(VENV) _skbuild dolfinx_mortar/_kernels*.so *.egg-info dolfinx_mortar.egg-info
+	rm -rf $(sort $(BUILD_DIR) build) $(VENV) _skbuild dolfinx_mortar/_kernels*.so *.egg-info dolfinx_mortar.egg-info

@@ -33,6 +33,8 @@ def _package_version() -> str:
         return "unknown"
 
 
+# first: a missing compiled module is explained here (an install, or the source tree on sys.path)
+from dolfinx_mortar import kernels as _kernels_check  # noqa: F401
 from dolfinx_mortar import kinds
 from dolfinx_mortar.bases import basis
 from dolfinx_mortar.bases.basis import MortarBasis

@@ -1,4 +1,4 @@
-"""Checks of the user's input that name the problem (DOLFINx 0.5.2, PETSc 3.18).
+"""Checks of the user's input that name the problem (DOLFINx 0.9 to 0.11).
 
 Bad input must fail early with a message that points at the offending entity,
 not later inside FFCx, the compiler or MUMPS.

@@ -228,11 +228,12 @@ class ContactTerm(ContactResults):
         clock = time.perf_counter()
         self.u.x.scatter_forward()
         self.state = None
-        # petsc4py 3.18 defers the destruction of every PETSc object whose
+        # petsc4py defers the destruction of a parallel PETSc object whose
         # Python handle dies to a collective garbage_cleanup, which nothing
         # else calls: the matrices of each evaluation piled up (ironing 3D at
-        # 2k dofs grew by 15 MB/s to over 5 GB). An evaluation is collective,
-        # so every rank reaches this point together.
+        # 2k dofs grew by 15 MB/s to over 5 GB with PETSc 3.18; a small block
+        # on 2 ranks of 3.22 by 0.5 MB per evaluation). An evaluation is
+        # collective, so every rank reaches this point together.
         PETSc.garbage_cleanup(self.mesh.comm)
         self.state = self.model.evaluate(self.u, self.mask(bcs))
         self._add("residual", clock)

@@ -1,4 +1,4 @@
-"""Two DOLFINx meshes as one mesh with two disconnected bodies (DOLFINx 0.5.2).
+"""Two DOLFINx meshes as one mesh with two disconnected bodies (DOLFINx 0.9 to 0.11).
 
 :class:`~dolfinx_mortar.solver.elastic.ContactProblem` takes an elastic master as a
 second body of the *same* mesh. Bodies meshed separately (two gmsh models, two

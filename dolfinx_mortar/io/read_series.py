@@ -1,6 +1,6 @@
 """Reading a written XDMF series back into numpy (needs h5py, Debian's python3-h5py).
 
-DOLFINx 0.5.2 reads meshes from XDMF but not functions; this reads what
+DOLFINx (0.9 to 0.11) reads meshes from XDMF but not functions; this reads what
 :class:`~dolfinx_mortar.io.xdmf_series.XdmfSeries` (and so every solve with
 ``output=``) wrote — in serial, on any number of ranks, after the run::
 

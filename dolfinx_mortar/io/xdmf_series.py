@@ -1,6 +1,6 @@
 """XDMF time series that survive a crash: every indexed step is complete on disk.
 
-DOLFINx 0.5.2's ``io.XDMFFile`` rewrites the ``.xdmf`` index in place
+DOLFINx's ``io.XDMFFile`` (seen in 0.5.2) rewrites the ``.xdmf`` index in place
 (pugixml truncates, then writes) right after adding a dataset to the ``.h5``
 and before the ``.h5`` is closed. A run killed during output left a 0-byte
 index (every earlier step lost) or an index naming a dataset not yet in the

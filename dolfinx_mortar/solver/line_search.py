@@ -90,9 +90,10 @@ class FullStepFirst:
     def suspended(self) -> Iterator[None]:
         """Full steps, unchecked, inside the ``with`` block (the frozen phase).
 
-        The pre-check stays attached: PETSc 3.18's SNESLineSearchSetPreCheck
-        ignores NULL arguments, so ``setLineSearchPreCheck(None)`` leaves PETSc
-        calling back into the freed Python context (a crash on the next solve).
+        The pre-check stays attached: SNESLineSearchSetPreCheck ignores NULL
+        arguments, so ``setLineSearchPreCheck(None)`` leaves PETSc calling back
+        into the freed Python context (a SEGV on the next solve with PETSc
+        3.18 and 3.22, a Python error with 3.25).
         """
         self.active = False
         try:

@@ -261,10 +261,6 @@ class NonlinearContactProblem:
         self.u.x.scatter_forward()
         return self.u
 
-    def __del__(self):
-        if self._snes is not None:
-            self._snes.destroy()
-
     # -- PETSc SNES --------------------------------------------------------------------
     def configure_ksp(self, ksp: PETSc.KSP) -> None:
         """What the contact terms need of the linear solver (GLS: the exact

@@ -1,4 +1,4 @@
-"""Slave surfaces made of tagged facets of a DOLFINx mesh (DOLFINx 0.5.2 API).
+"""Slave surfaces made of tagged facets of a DOLFINx mesh (DOLFINx 0.9 to 0.11).
 
 One of the few modules that call DOLFINx (docs/DESIGN.md, §Dependencies). The surface's
 functions are the (block) dofs of a Lagrange function space, numbered and
