@@ -27,6 +27,7 @@ from typing import Optional
 
 import numpy as np
 import numpy.typing as npt
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.bases.basis import MortarBasis
@@ -267,7 +268,9 @@ class ObstacleGap(GapModelBase):
     def curvature_blocks(self, coefficients: FloatArray, x: FloatArray) -> Optional[FloatArray]:
         """Element matrices of Σ_A c_A ∂²d̄_A/∂u², or None for a flat obstacle."""
         H = self.obstacle.hessian(x)
-        if not np.any(H):
+        # decided on every rank together: the matrix is assembled collectively, and a
+        # rank without slave cells sees no curvature (2 ranks of DOLFINx 0.11 hung)
+        if not self.slave.layout.comm.allreduce(bool(np.any(H)), op=MPI.LOR):
             return None
         tab, cells = self.tabulation, self.slave.cells
         nc, nq, nd = tab.phi.shape

@@ -179,4 +179,5 @@ def contact_balanced_partitioner(comm: MPI.Comm, contact_cells: BoolArray,
                 owner, np.arange(len(owner) + 1, dtype=np.int32))
         return _ghost_ranks(comm, graph, owner)
 
-    return dolfinx_compat.create_cell_partitioner(partition)
+    # with its ghost layer (GhostMode.shared_facet), as the module's text and its test say
+    return dolfinx_compat.create_cell_partitioner(partition, _cpp.mesh.GhostMode.shared_facet)
