@@ -14,7 +14,6 @@ gmsh models                             ``io.gmshio``, tuple   ``io.gmsh``, ``Me
 cell partitioner from a graph one       ``(part, mode)``       ``(part, mode, max_links)``
 geometry dofmap, coordinate element     ``dofmap``, ``cmap``   ``dofmaps[0]``, ``cmaps[0]``
 ``meshtags_from_entities`` entities     C++ adjacency list     ``graph.AdjacencyList``
-wrap an ``la.Vector`` for PETSc         ``la``                 ``la.petsc``
 ======================================  =====================  ==========================
 """
 from __future__ import annotations
@@ -33,8 +32,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 __all__ = ["model_to_mesh", "create_mesh", "create_cell_partitioner", "geometry_dofmap",
-           "coordinate_element", "adjacency_list", "ghosted_vector", "petsc_vector_wrap",
-           "gmsh_module"]
+           "coordinate_element", "adjacency_list", "cpp_adjacency_list", "ghosted_vector",
+           "tags_belong_to", "newton_solver_class", "gmsh_module"]
 
 
 def gmsh_module():
@@ -128,14 +127,6 @@ def ghosted_vector(index_map, bs: int) -> PETSc.Vec:
     ghosts = np.asarray(index_map.ghosts, dtype=PETSc.IntType)
     size = (index_map.size_local * bs, index_map.size_global * bs)
     return PETSc.Vec().createGhost(ghosts, size=size, bsize=bs, comm=index_map.comm)
-
-
-def petsc_vector_wrap(x: dolfinx.la.Vector) -> PETSc.Vec:
-    """A PETSc vector that shares the memory of the DOLFINx vector ``x``."""
-    if hasattr(dolfinx.la, "create_petsc_vector_wrap"):
-        return dolfinx.la.create_petsc_vector_wrap(x)
-    import dolfinx.la.petsc
-    return dolfinx.la.petsc.create_vector_wrap(x)
 
 
 def _cpp_object(wrapper):
