@@ -41,7 +41,9 @@ DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 # for another core type, so a test that depends on which side of zero
 # round-off lands fails here rather than on a user's machine (a zero-length
 # cell measures 5.6e-17 with SkylakeX kernels and 0 with Haswell's).
-SECOND_CORETYPE ?= Haswell
+# Empty: tools/second_coretype.py picks Haswell, or Sandybridge where Haswell's
+# kernels crash NumPy itself (OpenBLAS 0.3.34 on AVX-512 AMD hosts).
+SECOND_CORETYPE ?=
 
 # make shell-SUITE: the Debian root $(DEBIAN_ROOTS)/$(DEV_ROOT)-SUITE (tools/debian-root)
 DEBIAN_ROOTS ?= $(or $(DOLFINX_MORTAR_ROOTS),/var/tmp/dolfinx_mortar-roots)
@@ -125,7 +127,9 @@ test-mpi:
 	$(MPIRUN) $(PYTEST) -p no:cacheprovider tests
 
 test-coretype:
-	OPENBLAS_CORETYPE=$(SECOND_CORETYPE) $(PYTEST) -p no:cacheprovider tests
+	@coretype=$(or $(SECOND_CORETYPE),$$($(PYTHON) tools/second_coretype.py)) && \
+	echo "OPENBLAS_CORETYPE=$$coretype $(PYTEST) -p no:cacheprovider tests" && \
+	OPENBLAS_CORETYPE=$$coretype $(PYTEST) -p no:cacheprovider tests
 
 bench: setup
 	$(PYTHON) benchmarks/bench_basis_construction.py
