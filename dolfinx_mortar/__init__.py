@@ -53,6 +53,7 @@ _LAZY = {
     "RigidPlane": "dolfinx_mortar.contact.obstacles",
     "RigidSphere": "dolfinx_mortar.contact.obstacles",
     "RigidCylinder": "dolfinx_mortar.contact.obstacles",
+    "SurfacePressure": "dolfinx_mortar.contact.results",
 }
 
 __all__ = ["basis", "kinds", "lagrange", "nurbs", "MortarBasis", "KIND_NAMES",

@@ -5,6 +5,8 @@ Each figure, with what it is:
 
 - :meth:`ContactResults.nodal_pressures`: ``p_A``, the coefficients of the
   contact pressure in the partition-of-unity basis (``ε⟨d̄_A⟩``);
+- :meth:`ContactResults.surface_pressure`: the same ``p_A`` at the slave surface's
+  nodes only, with their coordinates (per rank or gathered);
 - :meth:`ContactResults.mortar_traction`: ``p* = Σ f_A M_A`` per slave cell,
   the traction whose virtual work the residual is;
 - :meth:`ContactResults.normal_force`: ``Σ_A W_A p_A``, the integral of the
@@ -17,6 +19,7 @@ Each figure, with what it is:
 from __future__ import annotations
 
 import warnings
+from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
@@ -36,6 +39,28 @@ DEEP_PENETRATION = 0.5
 SLIP_LIMIT = 1.0
 
 
+@dataclass(frozen=True)
+class SurfacePressure:
+    """The contact pressure at the nodes of a slave surface.
+
+    Attributes
+    ----------
+    x
+        Reference (undeformed) coordinates of the nodes, shape (n, gdim); (r, z) on an
+        axisymmetric mesh.
+    p
+        The contact pressure ``p_A`` at them, shape (n,); exactly 0 where the node is out of
+        contact.
+    global_index
+        The nodes' global indices in the displacement space's node numbering (which depends
+        on the partition: match runs on different numbers of ranks by ``x``).
+    """
+
+    x: FloatArray
+    p: FloatArray
+    global_index: npt.NDArray[np.int64]
+
+
 class ContactResults:
     """Results of a :class:`~dolfinx_mortar.contact.term.ContactTerm` at the present u."""
 
@@ -51,6 +76,34 @@ class ContactResults:
     def nodal_pressures(self, state: Optional[ContactState] = None) -> FloatArray:
         """Contact pressure ``p_A`` at the local slave-layout nodes (0 off the surface)."""
         return self.model.nodal_pressures(state or self.evaluate())
+
+    def surface_pressure(self, state: Optional[ContactState] = None,
+                         gather: bool = False) -> SurfacePressure:
+        """The contact pressure at the slave surface's nodes, with their coordinates.
+
+        Collective.
+
+        Parameters
+        ----------
+        state
+            A contact state; by default the one at the present u.
+        gather
+            False: the surface nodes this rank owns, in local order. True: every surface node
+            of all ranks, on every rank, sorted by coordinates (x first, then y, then z).
+        """
+        slave = self.slave
+        layout = slave.layout
+        n = layout.num_owned
+        nodes = np.flatnonzero(layout.on_cells(slave.cells)[:n])
+        part = SurfacePressure(slave.x[nodes], self.nodal_pressures(state)[nodes],
+                               layout.global_indices[nodes])
+        if not gather:
+            return part
+        parts = self.mesh.comm.allgather(part)
+        x = np.concatenate([q.x for q in parts]).reshape(-1, slave.gdim)
+        order = np.lexsort(x.T[::-1])
+        return SurfacePressure(x[order], np.concatenate([q.p for q in parts])[order],
+                               np.concatenate([q.global_index for q in parts])[order])
 
     def mortar_traction(self, state: Optional[ContactState] = None) -> FloatArray:
         """The contact traction ``p*`` at the nodes of every slave cell, (cells, nodes):

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Sequence
 
 import numpy as np
+import dolfinx
 from dolfinx import fem
 
 from dolfinx_mortar import dolfinx_compat
@@ -50,6 +51,16 @@ class ContactOutput:
         self.q_nodes = np.asarray(q_to_v) // V.dofmap.index_map_bs
         self.Q1 = (fem.functionspace(mesh, ("Lagrange", degree))
                    if self.Q.ufl_element().degree != degree else None)
+        # P2 pressure on a P1 mesh: the vertex values are copied, not interpolated; evaluating
+        # the P2 basis at the vertices left 1e-16 where the pressure is 0.
+        self.vertex_copy = None
+        if self.Q1 is not None and degree == 1:
+            def vertex_dofs(space):
+                layout = space.dofmap.dof_layout
+                local = [layout.entity_dofs(0, v)[0] for v in range(num_vertices)]
+                return space.dofmap.list.reshape(-1, layout.num_dofs)[:, local].ravel()
+            num_vertices = dolfinx.cpp.mesh.cell_num_entities(mesh.topology.cell_type, 0)
+            self.vertex_copy = (vertex_dofs(self.Q1), vertex_dofs(self.Q))
 
     def write(self, t: float, states: Sequence) -> None:
         """Add the step at pseudo-time ``t`` with each term's contact state."""
@@ -65,6 +76,10 @@ class ContactOutput:
         p.x.array[:] = total[self.q_nodes]
         if self.Q1 is not None:
             p1 = fem.Function(self.Q1, name="contact_pressure")
-            p1.interpolate(p)
+            if self.vertex_copy is not None:
+                q1_dofs, q_dofs = self.vertex_copy
+                p1.x.array[q1_dofs] = p.x.array[q_dofs]
+            else:
+                p1.interpolate(p)
             p = p1
         self.mesh_output.write((u1, p), t)

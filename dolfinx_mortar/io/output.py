@@ -7,15 +7,49 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
+import secrets
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 PathLike = Union[str, os.PathLike]
 
 
+@contextmanager
+def replacing(path: PathLike, suffix: str = "") -> Iterator[str]:
+    """Yield a new temporary file next to ``path``; rename it over ``path`` on success.
+
+    The temporary file is created as ``open`` creates files (mode 0666 less the umask), so the
+    result is as readable to other users and servers as any file the user writes; ``tempfile``'s
+    files are 0600. On any exception the temporary file is removed and ``path`` is untouched.
+
+    Parameters
+    ----------
+    path
+        Final location; its folder is created if needed.
+    suffix
+        Ending of the temporary name (some writers choose the format by it).
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    while True:
+        tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{suffix}"
+        try:
+            os.close(os.open(tmp, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
+            break
+        except FileExistsError:
+            continue
+    try:
+        yield str(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
 def write_atomically(path: PathLike, write: Callable[[str], None]) -> Path:
-    """Call ``write(tmp_path)`` and move the result to ``path``.
+    """Call ``write(tmp_path)`` and move the result to ``path`` (see :func:`replacing`).
 
     Parameters
     ----------
@@ -24,18 +58,9 @@ def write_atomically(path: PathLike, write: Callable[[str], None]) -> Path:
     write
         Writes the complete file at the temporary path it is given.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
-    try:
+    with replacing(path, Path(path).suffix) as tmp:
         write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
-    return path
+    return Path(path)
 
 
 def write_json(path: PathLike, data: Any) -> Path:

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Sequence
@@ -33,6 +32,8 @@ from xml.sax.saxutils import quoteattr
 
 from dolfinx import fem, io
 from dolfinx import mesh as dmesh
+
+from dolfinx_mortar.io.output import replacing
 
 XINCLUDE = "http://www.w3.org/2001/XInclude"
 #: the mesh is the first uniform grid of the index, as DOLFINx's default
@@ -125,18 +126,10 @@ class XdmfSeries:
             opening = " ".join(f"{k}={quoteattr(v)}" for k, v in attributes.items())
             text += [f"    <Grid {opening}>\n", *grids, "    </Grid>\n"]
         text.append("  </Domain>\n</Xdmf>\n")
-        fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=f".{self.path.name}.",
-                                   suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w") as f:
-                f.write("".join(text))
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, self.path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.remove(tmp)
-            raise
+        with replacing(self.path, ".tmp") as tmp, open(tmp, "w") as f:
+            f.write("".join(text))
+            f.flush()
+            os.fsync(f.fileno())
 
 
 def _text(element: ET.Element, level: int) -> str:

@@ -187,6 +187,11 @@ class ContactProblem:
     def nodal_pressures(self, state=None):
         return self.contact.nodal_pressures(state)
 
+    def surface_pressure(self, state=None, gather: bool = False):
+        """The contact pressure at the slave nodes with their coordinates
+        (:meth:`~dolfinx_mortar.contact.results.ContactResults.surface_pressure`)."""
+        return self.contact.surface_pressure(state, gather)
+
     def mortar_traction(self, state=None):
         return self.contact.mortar_traction(state)
 
