@@ -114,7 +114,8 @@ def frozen_model(options: ContactOptions, slave: LagrangeSurface,
         if u_nodes is not None:  # bases and segmentation in the configuration u
             slave, master = slave.moved(u_nodes), master.moved(u_nodes)
         coupling = MortarCoupling(slave, master, keep_points=pointwise,
-                                  search_radius=options.search_radius)
+                                  search_radius=options.search_radius,
+                                  interface_normals=True)
         model = MortarGap(coupling, options.kind, options.penalty, options.scaling,
                           None if u_nodes is None else u_vector,
                           boundary_modification=options.boundary_modification)

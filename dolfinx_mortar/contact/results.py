@@ -29,7 +29,9 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import DUAL_KINDS
+from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
+from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -101,7 +103,10 @@ class ContactResults:
             return part
         parts = self.mesh.comm.allgather(part)
         x = np.concatenate([q.x for q in parts]).reshape(-1, slave.gdim)
-        order = np.lexsort(x.T[::-1])
+        # coordinates equal up to round-off (a mesh generator's 0 may be -2e-18) are equal
+        # here, so that the order does not depend on where round-off lands
+        zero = zero_length(length_scale(x))
+        order = np.lexsort(np.round(x / zero).T[::-1])
         return SurfacePressure(x[order], np.concatenate([q.p for q in parts])[order],
                                np.concatenate([q.global_index for q in parts])[order])
 
@@ -241,6 +246,44 @@ class ContactResults:
                           "configuration of the bases (basis_configuration='initial', valid "
                           "to about one element of slip): the forces are no longer reliable; "
                           "use basis_configuration='previous' or 'current'",
+                          RuntimeWarning, stacklevel=3)
+
+
+    def warn_if_contact_reached_the_search_radius(
+            self, state: Optional[ContactState] = None) -> None:
+        """With bases frozen against an elastic master: warn (once) when the contact zone
+        reaches slave nodes that found no master within the search radius, though a master
+        lies beyond it. The pairs are found once per frozen configuration, along the normal
+        and within the search radius (the largest slave facet by default); where the
+        surfaces were further apart then, the pressure is cut off, with a peak at the last
+        paired node. Two equal cylinders with a = R/10 on a mesh graded to h = a/40 lost
+        the outer fifth of the contact zone that way and had the pressure 51% off."""
+        if (self.master is None or self.basis_configuration == "current"
+                or getattr(self, "_radius_warned", False)):
+            return
+        model, slave = self.model, self.slave
+        comm = self.mesh.comm
+        covered = model.covered
+        cells = slave.cells
+        # p is ε⟨d̄⟩: exactly 0 off the active set
+        active = self.nodal_pressures(state) > 0
+        at_edge = (active[cells].any(axis=1) & ~covered[cells].all(axis=1)
+                   if len(cells) else np.zeros(0, dtype=bool))
+        if not comm.allreduce(bool(at_edge.any()), op=MPI.LOR):
+            return
+        coupling = model.coupling
+        wider = MortarCoupling(coupling.slave, coupling.master,
+                               search_radius=4 * coupling.search_radius)
+        reached = slave.layout.on_cells(slave.cells[wider.pairs[:, 0]]) & ~covered
+        near_edge = np.zeros(slave.layout.size_local, dtype=bool)
+        near_edge[cells[at_edge].ravel()] = True
+        if comm.allreduce(bool(np.any(reached & near_edge)), op=MPI.LOR):
+            self._radius_warned = True
+            r = coupling.search_radius
+            warnings.warn(f"the contact zone reached slave nodes that found no master within "
+                          f"the search radius {r:.3g}, though a master lies beyond it: the "
+                          f"pressure is cut off there. Pass a larger search_radius (e.g. "
+                          f"{4 * r:.3g}) or basis_configuration='previous'",
                           RuntimeWarning, stacklevel=3)
 
 

@@ -244,6 +244,7 @@ class LoadPathSolver:
                         bar.update(stepper.fraction_of_steps - before)
                     for term, state in zip(self.contacts, states):
                         term.warn_if_slipped_too_far(state)
+                        term.warn_if_contact_reached_the_search_radius(state)
                     if writer is not None:
                         writer.write(target, states)
                     if on_step is not None:

@@ -303,13 +303,16 @@ PYBIND11_MODULE(_kernels, m)
        bool opposing_normals_only,
        double length_scale,
        bool keep_points,
-       bool axisymmetric)
+       bool axisymmetric,
+       bool project_along_normals)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
-      SegmentationOptions options{
-        opposing_normals_only, length_scale, keep_points, axisymmetric
-      };
+      SegmentationOptions options{ opposing_normals_only,
+                                   length_scale,
+                                   keep_points,
+                                   axisymmetric,
+                                   project_along_normals };
       MortarIntegrals r;
       {
         py::gil_scoped_release release;
@@ -364,6 +367,7 @@ PYBIND11_MODULE(_kernels, m)
     py::arg("length_scale") = 0.0,
     py::arg("keep_points") = false,
     py::arg("axisymmetric") = false,
+    py::arg("project_along_normals") = false,
     "Segmentation and slave-basis mortar integrals per cell pair");
   m.def(
     "current_pair_gaps",

@@ -141,6 +141,38 @@ mortar_integrals(const FacetSurface& slave,
       cache[c] = cell_pieces<double>(s.type, gdim, nodes, zero);
     return *cache[c];
   };
+  // the slave pieces' projection directions: the nodal normals interpolated
+  // at each piece's centre
+  auto slave_pieces_of =
+    [&](std::size_t c,
+        std::span<const double> nodes) -> const std::vector<SubFacet<double>>&
+  {
+    const bool made = slave_pieces[c].has_value();
+    auto& pieces = pieces_of(slave_pieces, slave, c, nodes);
+    if (made or !options.project_along_normals)
+      return pieces;
+    std::array<double, 9> N;
+    std::array<double, 18> dN;
+    for (SubFacet<double>& piece : *slave_pieces[c])
+    {
+      facet_shape_functions(slave.type,
+                            std::span(piece.reference_centre.data(), tdim),
+                            std::span(N.data(), ns),
+                            std::span(dN.data(), tdim * ns));
+      Vec3<double> m = { 0.0, 0.0, 0.0 };
+      for (int a = 0; a < ns; ++a)
+        for (int k = 0; k < gdim; ++k)
+          m[k] += N[a] * slave_normals[slave.cells[c * ns + a] * gdim + k];
+      const double length = vec3::norm(m);
+      if (length > geometric_tolerance)
+      {
+        for (double& v : m)
+          v /= length;
+        set_projection_direction(piece, m, 0.5);
+      }
+    }
+    return *slave_pieces[c];
+  };
 
   for (std::size_t p = 0; p < candidates.size() / 2; ++p)
   {
@@ -164,7 +196,7 @@ mortar_integrals(const FacetSurface& slave,
       std::span<const double>(slave_nodes),
       std::span<const double>(normals),
       std::span<const double>(master_nodes),
-      pieces_of(slave_pieces, slave, cs, slave_nodes),
+      slave_pieces_of(cs, slave_nodes),
       pieces_of(master_pieces, master, cm, master_nodes),
       points,
       weights,

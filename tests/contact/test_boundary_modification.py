@@ -111,12 +111,15 @@ def test_modification_is_refused_where_it_does_not_apply():
 
 
 @pytest.mark.parametrize("axisymmetric", [False, True])
-def test_two_touching_cylinders_see_no_false_penetration_by_default(axisymmetric):
+def test_two_touching_cylinders_see_their_true_separation_by_default(axisymmetric):
     """Two cylinders (or spheres) touching at a point part slowly: where the
     search radius ends, a slave facet is covered by the master near its far
-    node only, and a dual function (negative there) turns the 0.03 separation
-    into a penetration. The default switches the modification on for the dual
-    kinds against an elastic master; off, the false penetration is there."""
+    node only, and a dual function (negative there) mixes the separation of
+    its covered part into the node's gap. The default switches the modification
+    on for the dual kinds against an elastic master: the last covered node
+    sees the separation of the surfaces there. Off, it saw half of it (with
+    gaps along the slave normal alone, before the interface normals, it even
+    saw a penetration of 0.5 element lengths)."""
     from dolfinx_mortar import ContactTerm
     from demo_support.hertz_meshes import MASTER, SLAVE, quarter_disk_mesh
     from support import load_demo
@@ -126,16 +129,30 @@ def test_two_touching_cylinders_see_no_false_penetration_by_default(axisymmetric
     domain, tags = quarter_disk_mesh(1.0, a, h, "disk", 1, MPI.COMM_WORLD)
     u = fem.Function(fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,))))
 
-    def largest_gap(**options) -> float:
+    def gaps(**options) -> tuple[float, float]:
+        """The largest nodal gap and, at the covered node farthest from the axis,
+        its gap over the separation of the two unit circles there."""
         contact = ContactTerm(u, tags, SLAVE, master_tag=MASTER, kind="LcLS*", penalty=1e3,
                               axisymmetric=axisymmetric, **options)
         n = contact.slave.layout.num_owned
-        gaps = contact.nodal_gaps()[:n]
-        return domain.comm.allreduce(float(np.max(gaps, initial=-np.inf)), op=MPI.MAX)
+        gap = contact.nodal_gaps()[:n]
+        covered = contact.model.covered[:n]
+        r = contact.slave.x[:n, 0]
+        last = (float(np.max(r[covered], initial=-np.inf)), 0.0)
+        if covered.any():
+            i = np.flatnonzero(covered)[np.argmax(r[covered])]
+            separation = 2 * (1 - np.sqrt(1 - r[i] ** 2))
+            last = (float(r[i]), float(-gap[i] / separation))
+        comm = domain.comm
+        return (comm.allreduce(float(np.max(gap, initial=-np.inf)), op=MPI.MAX),
+                max(comm.allgather(last))[1])
+    largest, edge = gaps()
     # the bodies touch at the axis node only: no gap above round-off
-    assert largest_gap() <= 1e-12 * h
-    with pytest.warns(RuntimeWarning, match="boundary_modification=True"):
-        assert largest_gap(boundary_modification=False) > 0.5 * h
+    assert largest <= 1e-12 * h
+    assert abs(edge - 1) < 1e-3, edge
+    largest, edge = gaps(boundary_modification=False)
+    assert largest <= 1e-12 * h
+    assert edge < 0.6, edge
 
 
 def test_the_modification_is_on_by_default_only_where_it_applies():

@@ -7,7 +7,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar import KIND_NAMES, kernels
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface, ReferenceLagrange
-from dolfinx_mortar.mortar.coupling import MortarCoupling, to_scipy
+from dolfinx_mortar.mortar.coupling import MortarCoupling, segment_quadrature, to_scipy
 
 from dolfinx_mortar.surfaces.structured import flat_line, flat_patch
 
@@ -344,3 +344,39 @@ def test_swept_boxes_of_no_facets(degree):
     cells = np.zeros((0, surface.cells.shape[1]), dtype=np.int32)
     boxes = swept_facet_boxes(surface, surface.x, cells, 1.0, np.zeros(0))
     assert boxes.shape == (0, 6)
+
+
+def _mirrored_arcs(n: int = 8):
+    """P1 arcs y = ±(1 − sqrt(1 − x²)), x in [0, 0.4]: the slave above facing down, the master
+    its mirror image facing up, node i of one the mirror of node i of the other."""
+    x = np.linspace(0.0, 0.4, n + 1)
+    y = 1.0 - np.sqrt(1.0 - x**2)
+    cells = np.column_stack([np.arange(n), np.arange(1, n + 1)]).astype(np.int32)
+    slave = np.column_stack([x, y])
+    master = np.column_stack([x, -y])
+    return slave, cells, master, cells[:, ::-1].copy()
+
+
+@pytest.mark.parametrize("along_normals", [True, False])
+def test_projection_along_the_given_normals_pairs_mirror_points(along_normals):
+    """With vertical normals on mirrored arcs, projecting along them pairs each slave point
+    with its mirror image: ∫N_A N^m_C = ∫N_A N_C and the gap is twice the slave's height, to
+    round-off. Projecting along the facets' own (tilted) normals, as for the slave's own
+    normals, shifts the master points outward and both are off."""
+    xs, cs, xm, cm = _mirrored_arcs()
+    n = len(xs)
+    normals = np.tile([0.0, -1.0], (n, 1))
+    candidates = np.array([(i, j) for i in range(len(cs)) for j in range(len(cm))],
+                          dtype=np.int32)
+    points, weights = segment_quadrature(1, 2)
+    line = kernels.FacetType.P1_line
+    r = kernels.mortar_integrals(line, xs, cs, normals, line, xm, cm, candidates, points,
+                                 weights, project_along_normals=along_normals)
+    D, M, gap = np.zeros((n, n)), np.zeros((n, n)), np.zeros(n)
+    for (s, m), Dp, Mp, gp in zip(r["pairs"], r["D"], r["M"], r["gap"]):
+        D[np.ix_(cs[s], cs[s])] += Dp
+        M[np.ix_(cs[s], cm[m])] += Mp
+        gap[cs[s]] += gp
+    tol = 1e-13 * np.max(np.abs(D))
+    mirrored = np.max(np.abs(M - D)) < tol and np.max(np.abs(gap + 2 * D @ xs[:, 1])) < tol
+    assert mirrored == along_normals, (np.max(np.abs(M - D)), tol)

@@ -54,6 +54,12 @@ struct SegmentationOptions
   /// Axisymmetric (2D only, coordinates (r, z)): integrate over the surface
   /// of revolution, dμ = 2π r ds with r the slave point's first coordinate.
   bool axisymmetric = false;
+  /// Project master points onto each slave piece along the slave normals
+  /// interpolated at the piece's centre instead of the piece's own normal,
+  /// so that pairing and gap follow one direction field (normals that are
+  /// not the slave's own, such as interface normals). A piece whose
+  /// interpolated normal is within 60° of its plane keeps its own normal.
+  bool project_along_normals = false;
 };
 
 /// Segment candidate slave–master cell pairs and integrate on the segments.
@@ -61,9 +67,11 @@ struct SegmentationOptions
 /// Per slave sub-facet (the facet itself for linear facets; 2 or 4 flat
 /// pieces for quadratic ones): an auxiliary plane (line in 2D) through its
 /// centre with its normal n₀; master sub-facets are projected onto it along
-/// n₀ and clipped with it; the clip polygon is triangulated from its centroid
-/// and integrated with the given rule; each point is projected back along n₀
-/// onto the slave and the master cells (Newton). The gap is
+/// n₀ (or the interpolated nodal normal, SegmentationOptions::
+/// project_along_normals) and clipped with it; the clip polygon is
+/// triangulated from its centroid and integrated with the given rule; each
+/// point is projected back along the same direction onto the slave and the
+/// master cells (Newton). The gap is
 /// d = (x_s − x_m)·n with n the interpolated averaged nodal normal.
 ///
 /// @param[in] slave, master The surfaces (current configuration)

@@ -135,7 +135,38 @@ struct SubFacet
   std::vector<Vec3<T>> polygon;
   Vec3<T> centre, normal, e1, e2;
   T size; ///< length (2D) or area (3D)
+  /// The direction master points are projected along onto the piece's
+  /// plane: its normal, unless set_projection_direction tilted it.
+  Vec3<T> direction;
+  bool oblique = false; ///< direction is not the normal
+
+  /// Plane coordinates (along e1, e2) of the point x projected on the plane
+  /// along the direction.
+  std::array<T, 2> plane_coordinates(const Vec3<T>& x) const
+  {
+    Vec3<T> r = vec3::sub(x, centre);
+    if (oblique)
+    {
+      const T along = vec3::dot(r, normal) / vec3::dot(direction, normal);
+      for (int k = 0; k < 3; ++k)
+        r[k] -= along * direction[k];
+    }
+    return { vec3::dot(r, e1), vec3::dot(r, e2) };
+  }
 };
+
+/// Project master points onto the piece along the unit vector @p m instead
+/// of its normal (kept when m is within @p min_cosine of the plane: the
+/// projection would stretch the master without bound).
+template<typename T>
+void
+set_projection_direction(SubFacet<T>& f, const Vec3<T>& m, double min_cosine)
+{
+  if (!(value(vec3::dot(m, f.normal)) > min_cosine))
+    return;
+  f.direction = m;
+  f.oblique = true;
+}
 
 /// The longest edge of a polygon, on the values (it only takes decisions).
 template<typename Point>
@@ -206,6 +237,7 @@ make_subfacet(FacetType type,
     f.e1 = { t[0] / f.size, t[1] / f.size, 0.0 };
     f.normal = { f.e1[1], -f.e1[0], 0.0 };
     f.e2 = { 0.0, 0.0, 0.0 };
+    f.direction = f.normal;
     return f;
   }
   // |n| is twice the area of a triangle, and of a quadrilateral's projection
@@ -236,6 +268,7 @@ make_subfacet(FacetType type,
     flat.push_back(
       { dot(sub(p, f.centre), f.e1), dot(sub(p, f.centre), f.e2) });
   f.size = absolute(signed_area(flat));
+  f.direction = f.normal;
   return f;
 }
 
@@ -332,12 +365,12 @@ reference_from_plane(const std::vector<std::array<T, 2>>& vertices, int tdim)
            PlaneAffine<T>{ -(i10 * P0[0] + i11 * P0[1]), i10, i11 } };
 }
 
-/// (X_m, t) with x_m(X_m) = x + t·n_s, x = centre + u·e1 + v·e2, for a flat
+/// (X_m, t) with x_m(X_m) = x + t·m, x = centre + u·e1 + v·e2, for a flat
 /// master piece with vertices @p Q (in reference order) and the slave piece
-/// @p sf: the master's reference coordinates then t, as functions of (u, v).
-/// The system is linear; its matrix [∂x_m/∂X_m, −n_s] is not singular when
-/// the master's projection on the slave plane has an area, which the
-/// clipping has established.
+/// @p sf with projection direction m: the master's reference coordinates
+/// then t, as functions of (u, v). The system is linear; its matrix
+/// [∂x_m/∂X_m, −m] is not singular when the master's projection on the slave
+/// plane has an area, which the clipping has established.
 template<typename T>
 std::array<PlaneAffine<T>, 3>
 master_from_plane(const SubFacet<T>& sf,
@@ -345,7 +378,7 @@ master_from_plane(const SubFacet<T>& sf,
                   int tdim)
 {
   using namespace vec3;
-  const Vec3<T> c = { -sf.normal[0], -sf.normal[1], -sf.normal[2] };
+  const Vec3<T> c = { -sf.direction[0], -sf.direction[1], -sf.direction[2] };
   const Vec3<T> a = sub(Q[1], Q[0]);
   // rows of the inverse matrix times its determinant
   std::array<Vec3<T>, 3> rows;
@@ -379,8 +412,8 @@ template<typename T>
 struct FlatPoint
 {
   std::array<T, 3> Ns{}, Nm{}; ///< slave and master shape functions
-  T t{};       ///< x_m = x_s + t·n_s: the gap vector is −t·n_s
-  T s{};       ///< n_s·n
+  T t{};                       ///< x_m = x_s + t·m: the gap vector is −t·m
+  T s{};       ///< m·n (m: the slave piece's projection direction)
   Vec3<T> n{}; ///< the interpolated nodal normal
   T r{};       ///< x_s[0], the radius (axisymmetric)
 };
@@ -527,17 +560,14 @@ integrate_pieces(FacetType slave_type,
   {
     const SubFacet<G>* sf = &slave_piece;
     auto plane_coords = [&](const Vec3<G>& x) -> P2
-    {
-      const Vec3<G> r = sub(x, sf->centre);
-      return { dot(r, sf->e1), dot(r, sf->e2) };
-    };
+    { return sf->plane_coordinates(x); };
     std::vector<P2> slave_polygon;
     for (const Vec3<G>& x : sf->polygon)
       slave_polygon.push_back(plane_coords(x));
     // the flat path's slave map and normal, made when a piece pair first
     // overlaps (most candidate pairs do not)
     std::array<PlaneAffine<G>, 2> slave_map;
-    Vec3<T> slave_normal{};
+    Vec3<T> projection_direction{};
     bool slave_map_made = false;
 
     for (const SubFacet<G>& mf : master_pieces)
@@ -627,17 +657,17 @@ integrate_pieces(FacetType slave_type,
       if (flat and !cells.empty())
       {
         // Both cells affine: the reference coordinates, the distance t to
-        // the master plane along n_s and the interpolated normal are affine
-        // in (u, v). They are found at the cells' vertices and interpolated
-        // at the quadrature points, where only |n| and the gap's products
-        // remain: for a Jet, a tenth of the projections' products per point.
-        // The slave point is x itself (the slave plane holds the slave
-        // cell), so x_s − x_m = −t·n_s.
+        // the master plane along the projection direction m and the
+        // interpolated normal are affine in (u, v). They are found at the
+        // cells' vertices and interpolated at the quadrature points, where
+        // only |n| and the gap's products remain: for a Jet, a tenth of the
+        // projections' products per point. The slave point is x itself (the
+        // slave plane holds the slave cell), so x_s − x_m = −t·m.
         if (!slave_map_made)
         {
           slave_map = reference_from_plane(slave_polygon, tdim);
           for (int k = 0; k < 3; ++k)
-            slave_normal[k] = lift(sf->normal[k]);
+            projection_direction[k] = lift(sf->direction[k]);
           slave_map_made = true;
         }
         const std::array<PlaneAffine<G>, 3> master_map =
@@ -667,7 +697,7 @@ integrate_pieces(FacetType slave_type,
           for (int a = 0; a < ns; ++a)
             for (int k = 0; k < gdim; ++k)
               f.n[k] += f.Ns[a] * slave_normals[a * gdim + k];
-          f.s = dot(slave_normal, f.n);
+          f.s = dot(projection_direction, f.n);
           if (axisymmetric)
             f.r = lift(sf->centre[0] + p[0] * sf->e1[0] + p[1] * sf->e2[0]);
         }
@@ -703,7 +733,7 @@ integrate_pieces(FacetType slave_type,
         continue;
       }
 
-      const Point3 direction = values(sf->normal);
+      const Point3 direction = values(sf->direction);
       for (const Cell& cell : cells)
         for (std::size_t q = 0; q < nq; ++q)
         {
@@ -743,10 +773,10 @@ integrate_pieces(FacetType slave_type,
           else
           {
             Xs = refine_projection<G>(
-                   slave_type, gdim, slave_nodes, x, sf->normal, ps)
+                   slave_type, gdim, slave_nodes, x, sf->direction, ps)
                    .first;
             Xm = refine_projection<G>(
-                   master_type, gdim, master_nodes, x, sf->normal, pm)
+                   master_type, gdim, master_nodes, x, sf->direction, pm)
                    .first;
           }
           Vec3<G> xs, xm;
