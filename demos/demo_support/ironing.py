@@ -206,7 +206,9 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     Q = fem.functionspace(domain, ("DG", 0))
     E = fem.Function(Q)
     E.x.array[:] = args.E
-    E.x.array[cell_tags.find(DIE)] = E_DIE * args.E
+    # by the dofmap: a DG0 dof is not its cell's index (DOLFINx 0.9 and later reorder the
+    # dofs; with the cell indices the die's stiffness went to cells of the slab)
+    E.x.array[Q.dofmap.list[cell_tags.find(DIE)].ravel()] = E_DIE * args.E
     E.x.scatter_forward()
     fdim = dim - 1
     bottom = fem.locate_dofs_topological(V, fdim, facet_tags.find(SLAB_BOTTOM))

@@ -124,6 +124,9 @@ class ContactBlockPreconditioner:
         self.apply(pc, r, e)
 
     def view(self, pc: PETSc.PC, viewer: PETSc.Viewer) -> None:
+        if self.amg is None:   # -ksp_view_pre: before the first set-up
+            viewer.printfASCII("contact block preconditioner (not set up yet)\n")
+            return
         viewer.printfASCII(f"contact block preconditioner: {self.block_size} rows solved "
                            f"exactly, multigrid ({self.amg.getPC().getType()}) for the rest\n")
 

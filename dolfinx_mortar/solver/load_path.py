@@ -62,8 +62,9 @@ class LoadPathSolver:
         augmented = any(term.augmented for term in problem.contacts)
         gdim = problem.u.function_space.mesh.geometry.dim
         #: "direct" or "iterative", as chosen for this problem
+        current = any(term.basis_configuration == "current" for term in problem.contacts)
         self.linear_solver = choose_linear_solver(linear_solver, problem.num_dofs, gdim,
-                                                  augmented)
+                                                  augmented, current)
         #: the iterative path's preconditioner, once made
         self.preconditioner: Optional[ContactBlockPreconditioner] = None
         self.petsc_options = dict(petsc_options or {})
