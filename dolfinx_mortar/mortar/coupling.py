@@ -31,7 +31,7 @@ from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
-from dolfinx_mortar.tolerance import length_scale, zero_length
+from dolfinx_mortar.tolerance import GEOMETRIC_TOLERANCE, length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -134,14 +134,22 @@ def interface_nodal_normals(slave: LagrangeSurface, slave_normals: FloatArray,
         slave.layout.sum_at_functions(
             slave_cells, np.repeat(weighted[:, k, None], slave_cells.shape[1], axis=1))
         for k in range(gdim)])
-    covered = slave.layout.on_cells(slave_cells)
+    # A node whose opposite normals cancel, or whose bisector vanishes (a master facing its
+    # own way), keeps its own normal: the sum is judged against the paired area it sums,
+    # the bisector of unit vectors against the dimensionless tolerance.
+    paired_area = slave.layout.sum_at_functions(
+        slave_cells, np.repeat(np.asarray(areas, dtype=np.float64)[:, None],
+                               slave_cells.shape[1], axis=1))
     length = np.linalg.norm(opposite, axis=1)
+    usable = (slave.layout.on_cells(slave_cells)
+              & (length > GEOMETRIC_TOLERANCE * paired_area))
     unit_opposite = np.divide(opposite, length[:, None], out=np.zeros_like(opposite),
-                              where=covered[:, None])
+                              where=usable[:, None])
     bisector = slave_normals - unit_opposite
     length = np.linalg.norm(bisector, axis=1)
-    return np.where(covered[:, None],
-                    bisector / np.where(covered, length, 1.0)[:, None], slave_normals)
+    usable &= length > GEOMETRIC_TOLERANCE
+    return np.where(usable[:, None],
+                    bisector / np.where(usable, length, 1.0)[:, None], slave_normals)
 
 
 def swept_facet_boxes(surface: LagrangeSurface, x: FloatArray, cells: npt.NDArray[np.int32],
