@@ -124,12 +124,15 @@ def interface_nodal_normals(slave: LagrangeSurface, slave_normals: FloatArray,
         along ``slave_normals``.
     """
     gdim = slave_normals.shape[1]
-    facet_normals = _kernels.element_node_normals(master.facet_type, master.x, master.cells,
-                                                  size_weighted=False).mean(axis=1)
-    facet_normals /= np.linalg.norm(facet_normals, axis=1)[:, None]
     pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    # the normals of the paired master facets only: the gathered master is every rank's
+    paired, which = np.unique(pairs[:, 1], return_inverse=True)
+    facet_normals = _kernels.element_node_normals(
+        master.facet_type, master.x, np.ascontiguousarray(master.cells[paired]),
+        size_weighted=False).mean(axis=1).reshape(len(paired), gdim)
+    facet_normals /= np.linalg.norm(facet_normals, axis=1)[:, None]
     slave_cells = slave.cells[pairs[:, 0]]
-    weighted = facet_normals[pairs[:, 1]] * np.asarray(areas)[:, None]
+    weighted = facet_normals[which.ravel()] * np.asarray(areas)[:, None]
     opposite = np.column_stack([
         slave.layout.sum_at_functions(
             slave_cells, np.repeat(weighted[:, k, None], slave_cells.shape[1], axis=1))
