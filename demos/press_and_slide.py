@@ -295,6 +295,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
         "refine": args.refine, "h": h, "slide_in_elements": args.slide / h,
         "radius": args.radius, "depth": args.depth * args.radius, "dofs": int(dofs),
         "load_steps": len(result.steps), "requested_steps": steps,
+        "cut_backs": len(result.cut_backs),
         "newton_iterations": result.newton_iterations,
         "max_newton_per_step": max(r["newton_iterations"] for r in rows),
         "predictor": args.predictor,

@@ -16,7 +16,8 @@ from dolfinx_mortar import ContactTerm, NonlinearContactProblem, LoadPathSolver
 assert (root.level, list(root.handlers), list(root.filters)) == before, "root logger changed"
 names = set(dir(dolfinx_mortar))
 missing = {"ContactTerm", "NonlinearContactProblem", "LoadPathSolver", "ContactProblem",
-           "NewtonSolver", "RigidPlane", "RigidSphere", "RigidCylinder", "__version__"} - names
+           "NewtonSolver", "RigidPlane", "RigidSphere", "RigidCylinder", "SurfacePressure",
+           "DegenerateGeometryError", "__version__"} - names
 assert not missing, missing
 print(dolfinx_mortar.__version__)
 """

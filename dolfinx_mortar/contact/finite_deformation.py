@@ -254,6 +254,9 @@ class CurrentSurfaceGap(GapModelBase):
 
         ``mask``: 1 on free dofs, 0 on Dirichlet dofs (columns to drop).
         """
+        # a trial point that collapses a facet is refused by name, not by a
+        # singular metric inside the area element
+        self.slave.check_displaced(u_nodes)
         e = self._elements(u_nodes)
         cells, layout = self.slave.cells, self.slave.layout
         nc, nd = cells.shape

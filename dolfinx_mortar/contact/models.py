@@ -7,7 +7,7 @@ through :class:`~dolfinx_mortar.contact.state.GapModel` alone.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Optional
 
 import numpy as np
@@ -20,9 +20,11 @@ from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap, gap_kind
 from dolfinx_mortar.contact.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.state import GapModel
-from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, is_global, parse_kind
+from dolfinx_mortar.kinds import (DUAL_KINDS, BasisKind, KindLike, is_global, kind_name,
+                                  parse_kind)
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -129,3 +131,53 @@ def moved(u_nodes: FloatArray, since: Optional[FloatArray], comm: MPI.Comm) -> b
     """Whether the nodal displacement differs from ``since`` (None: zero) on any rank."""
     local = np.any(u_nodes != 0) if since is None else not np.array_equal(u_nodes, since)
     return comm.allreduce(bool(local), op=MPI.LOR)
+
+
+def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
+                             master: Optional[LagrangeSurface], current: GapModel, u,
+                             u_nodes: FloatArray) -> None:
+    """Refuse a dual kind on the current surface against an elastic master
+    where it reads a penetration that is not there (NotImplementedError).
+
+    A dual function is negative over part of its element: where the master
+    covers only that part (cut by the search radius, or by the master's
+    edge), ``∫ M̄_A d`` turns a separation into a penetration (two equal
+    cylinders at u = 0: 0.009 where the search radius cuts, 0.037 at the
+    surfaces' end with a larger radius, and Newton diverged to vertices of
+    1e87). In the initial
+    and previous configurations the boundary modification cures it; on the
+    current surface it is not differentiated (which elements are partly
+    covered changes with u). Its nodal gaps are compared here, where the term
+    is made, with the modified ones of the frozen model: a node that only the
+    current surface sees penetrating stops the construction, with the way
+    out. A master that covers the slave's elements in full (a cylinder on a
+    wider block) passes.
+    """
+    if not (options.basis_configuration == "current" and master is not None
+            and options.kind in DUAL_KINDS and options.active_set == "nodal"):
+        return
+    frozen = replace(options, basis_configuration="previous", boundary_modification=True)
+    modified = frozen_model(frozen, slave, master, None, u_nodes, u.x.petsc_vec.copy())
+    owned = slave.layout.num_owned
+    gaps = current.evaluate(u, None).gaps[:owned]
+    reference = modified.evaluate(u, None).gaps[:owned]
+    comm = slave.layout.comm
+    tolerance = zero_length(length_scale(slave.x, comm))
+    false = (gaps > tolerance) & (reference <= tolerance)
+    worst = comm.allreduce((float(gaps[false].max()) if false.any() else 0.0, comm.rank),
+                           op=MPI.MAXLOC)
+    count = comm.allreduce(int(false.sum()))
+    if count == 0:
+        return
+    where = ""
+    if comm.rank == worst[1]:
+        node = int(np.flatnonzero(false)[np.argmax(gaps[false])])
+        where = np.array2string(slave.x[node] + u_nodes[node], precision=4)
+    where = comm.bcast(where, root=worst[1])
+    raise NotImplementedError(
+        f"{kind_name(options.kind)} on the current surface against an elastic master reads "
+        f"a false penetration at {count} slave node(s) (largest {worst[0]:.3g} at {where}): "
+        "the master covers their elements only in part (cut by the search radius or the "
+        "master's edge), where the dual functions are negative. The boundary modification that cures this in the 'initial' and "
+        "'previous' configurations is not differentiated for 'current'. Use a kind with "
+        "positive functions (kind='LmLS*' or 'LmLS') or basis_configuration='previous'.")

@@ -30,7 +30,8 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact.active_set import gap_closing_force, stiffened_nodes
 from dolfinx_mortar.contact.augmented import AugmentedNewtonStep
-from dolfinx_mortar.contact.models import ContactOptions, current_model, frozen_model, moved
+from dolfinx_mortar.contact.models import (ContactOptions, current_model, frozen_model, moved,
+                                           refuse_false_penetration)
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.results import ContactResults
 from dolfinx_mortar.contact.sparse_products import PatternTrackingAdd
@@ -150,7 +151,10 @@ class ContactTerm(ContactResults):
         #: stiffened (:meth:`assemble_jacobian`)
         self.stiffened_rows: np.ndarray = np.zeros(0, dtype=PETSc.IntType)
         self.model: GapModel = self._build(None)
+        refuse_false_penetration(self.options, self.slave, self.master, self.model, u,
+                                 nodal_displacement(self.slave, u))
         self.warn_deep_initial_penetration()
+        self.warn_if_no_master_is_in_reach()
 
     # -- configuration ---------------------------------------------------------------
     @property

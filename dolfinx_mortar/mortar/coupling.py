@@ -27,6 +27,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
+from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
@@ -388,7 +389,7 @@ class MortarCoupling:
                   f"{np.array2string(master_copy.x[master_copy.cells[c]], precision=17, separator=', ')}"
                   for c in r["degenerate_master_facets"][:5]]
         if lines:
-            raise ValueError(
+            raise DegenerateGeometryError(
                 f"degenerate contact facets (length or height at most the zero length "
                 f"{self.zero_length:.3g} = tolerance × length scale {self.length_scale:.3g}): "
                 + "; ".join(lines))

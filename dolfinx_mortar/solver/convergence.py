@@ -147,13 +147,19 @@ class EquilibriumTest:
         return f"{fnorm / self.reference:.2e}" if self.reference > 0 else "inf"
 
 
-def describe_failure(snes: PETSc.SNES, test: EquilibriumTest) -> str:
+def describe_failure(snes: PETSc.SNES, test: EquilibriumTest,
+                     evaluation_error: Optional[str] = None) -> str:
     """What stopped a failed Newton solve, in words: the SNES reason's name and,
-    for a failed linear solve, the KSP's reason and iteration count."""
+    for a failed linear solve, the KSP's reason and iteration count; for a
+    NaN residual that the problem could not evaluate, its
+    ``evaluation_error``."""
     reason = snes.getConvergedReason()
     name = reason_name(reason)
     if test.cause is not None:   # stopped by the test itself: its words say more
         return test.cause
+    if evaluation_error is not None:
+        return (f"{name}: the residual could not be evaluated at a Newton iterate "
+                f"(the step deformed the contact surfaces too far): {evaluation_error}")
     if reason == _SNES.DIVERGED_LINEAR_SOLVE:
         ksp = snes.getKSP()
         return (f"{name}: linear solve failed: KSP "

@@ -1,5 +1,6 @@
-"""The line search of the current-surface phase: the full Newton step when it
-lowers the residual norm, PETSc's ``l2`` step length otherwise.
+"""The library's line search: the full Newton step when it lowers the
+residual norm, PETSc's ``l2`` step length otherwise, and never a step to a
+point where the residual is not finite.
 
 PETSc's ``l2`` line search evaluates the residual three times per Newton
 iteration (at λ = 1, at λ = 1/2 and at its secant minimizer), also where the
@@ -11,11 +12,19 @@ where a node at the contact edge changes state, and ``bt`` shrank its steps
 there. :class:`FullStepFirst` keeps ``l2``'s answer for such steps and takes
 the full step, at the cost of one evaluation, when it already lowers ``‖F‖``.
 
-petsc4py 3.18 cannot define a line search in Python; this one runs as the
+Where the full step only needs to stay finite (the frozen phase of a
+``"current"`` step, and the frozen configurations), it takes full steps and
+halves a step whose residual is NaN or infinite: a finite-strain law with
+``ln J`` is not defined past J = 0, and ``basic`` ended such steps in
+``DIVERGED_FUNCTION_NANORINF`` (a neo-Hookean block pressed and slid by a
+rigid disk: 72 steps and 60 cut-backs for the 12 requested).
+
+petsc4py cannot define a line search in Python; this one runs as the
 pre-check of the ``basic`` line search, which then takes ``x − y`` with the
 direction ``y`` the pre-check scaled. The accepted trial residual is offered
 to the next residual evaluation (:meth:`NonlinearContactProblem.offer_residual`),
-which is the basic line search's, at the same point.
+which is the basic line search's, at the same point: a full step costs no
+evaluation more than ``basic``.
 """
 from __future__ import annotations
 
@@ -34,6 +43,10 @@ SUFFICIENT_DECREASE = 1e-4
 #: PETSc's ``snes_linesearch_minlambda`` and ``snes_linesearch_maxstep`` defaults,
 #: the bounds of ``l2``'s step length
 MIN_LAMBDA, MAX_STEP = 1e-12, 1e8
+#: halvings of a step whose residual is not finite before the step is given up
+#: (2⁻¹⁰ of the Newton step; then the basic line search fails and the load
+#: step is cut back)
+MAX_HALVINGS = 10
 
 
 def l2_step_length(f0: float, f_mid: float, f1: float) -> float:
@@ -60,7 +73,8 @@ def l2_step_length(f0: float, f_mid: float, f1: float) -> float:
 
 class FullStepFirst:
     """SNES line-search pre-check: the full step if it lowers ``‖F‖`` enough,
-    else the step length of PETSc's ``l2`` (see the module).
+    else the step length of PETSc's ``l2``; a step whose residual is not
+    finite is halved first (see the module).
 
     Parameters
     ----------
@@ -70,36 +84,43 @@ class FullStepFirst:
         (:class:`~dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem`).
     snes
         The SNES it is attached to (its residual norm at the current iterate).
+    shorten
+        Whether a finite full step that does not lower ``‖F‖`` enough is
+        shortened to ``l2``'s length (the current surface); otherwise only
+        steps to non-finite residuals are shortened (:meth:`full_steps_only`).
 
     Attributes
     ----------
-    full_steps, cut_steps
-        How many steps it took in full and how many it shortened.
+    full_steps, cut_steps, halved_steps
+        How many steps it took in full, how many it shortened to ``l2``'s
+        length, and how many it halved because the residual was not finite.
     """
 
-    def __init__(self, problem: "NonlinearContactProblem", snes: PETSc.SNES):
+    def __init__(self, problem: "NonlinearContactProblem", snes: PETSc.SNES,
+                 shorten: bool = True):
         self.problem, self.snes = problem, snes
-        self.full_steps = self.cut_steps = 0
-        self.active = True
+        self.full_steps = self.cut_steps = self.halved_steps = 0
+        self.shorten = shorten
 
     def attach(self) -> None:
         """Run as the pre-check of the SNES's line search (which must be ``basic``)."""
         self.snes.setLineSearchPreCheck(self)
 
     @contextmanager
-    def suspended(self) -> Iterator[None]:
-        """Full steps, unchecked, inside the ``with`` block (the frozen phase).
+    def full_steps_only(self) -> Iterator[None]:
+        """Inside the ``with`` block (the frozen phase), full steps unless their
+        residual is not finite.
 
         The pre-check stays attached: SNESLineSearchSetPreCheck ignores NULL
         arguments, so ``setLineSearchPreCheck(None)`` leaves PETSc calling back
         into the freed Python context (a SEGV on the next solve with PETSc
         3.18 and 3.22, a Python error with 3.25).
         """
-        self.active = False
+        shorten, self.shorten = self.shorten, False
         try:
             yield
         finally:
-            self.active = True
+            self.shorten = shorten
 
     def _squared_norm_at(self, x: PETSc.Vec, y: PETSc.Vec, step: float,
                          point: PETSc.Vec, residual: PETSc.Vec) -> float:
@@ -111,16 +132,24 @@ class FullStepFirst:
         """The pre-check at the iterate ``x`` with the Newton direction ``y``
         (the basic line search then takes ``x − y``); returns whether it
         scaled ``y``."""
-        if not self.active:
-            return False
         f0 = self.snes.getFunctionNorm() ** 2
         point, residual = x.duplicate(), self.problem.vector().duplicate()
         try:
             f1 = self._squared_norm_at(x, y, 1.0, point, residual)
-            if f1 <= (1.0 - 2.0 * SUFFICIENT_DECREASE) * f0:
-                self.full_steps += 1
+            halvings = 0
+            while not math.isfinite(f1) and halvings < MAX_HALVINGS:
+                # halving is exact in floating point: the basic line search's
+                # x − y is this point bit for bit, and takes the offer below
+                y.scale(0.5)
+                halvings += 1
+                f1 = self._squared_norm_at(x, y, 1.0, point, residual)
+            self.halved_steps += halvings > 0
+            if not math.isfinite(f1):
+                return halvings > 0     # basic fails on it: the load step is cut back
+            if not self.shorten or f1 <= (1.0 - 2.0 * SUFFICIENT_DECREASE) * f0:
+                self.full_steps += halvings == 0
                 self.problem.offer_residual(point, residual)
-                return False
+                return halvings > 0
             f_mid = self._squared_norm_at(x, y, 0.5, point, residual)
             step = l2_step_length(f0, f_mid, f1)
             self.cut_steps += 1

@@ -4,13 +4,16 @@ The user passes a function of pseudo-time ``t ∈ (0, 1]`` that updates their
 own Constants and Functions — Dirichlet values, tractions, body forces, a
 rigid obstacle's position (``obstacle.move_to``). Each step is solved by SNES
 (options prefix ``dolfinx_mortar_`` unless told otherwise, plus the
-``petsc_options`` given); a step that fails is halved and retried, cut steps
-regrow after successes, and after too many failures
-:class:`~dolfinx_mortar.solver.convergence.ContactDivergenceError` names every
-attempt's cause with its residual history. Converged steps go to XDMF.
+``petsc_options`` given); a step that fails is halved and retried (one
+warning through :mod:`logging` per cut-back, each recorded in
+:attr:`SolveResult.cut_backs`), cut steps regrow after successes, and after
+too many failures :class:`~dolfinx_mortar.solver.convergence.ContactDivergenceError`
+names every attempt's cause with its residual history. Converged steps go to XDMF.
 """
 from __future__ import annotations
 
+import logging
+import math
 import time
 from pathlib import Path
 from typing import Callable, Optional, Union
@@ -31,6 +34,8 @@ from dolfinx_mortar.solver.newton_start import PathExtrapolation, close_gaps
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 from dolfinx_mortar.solver.step_results import SolveResult, StepResult
+
+logger = logging.getLogger(__name__)
 
 
 class LoadPathSolver:
@@ -62,9 +67,8 @@ class LoadPathSolver:
         augmented = any(term.augmented for term in problem.contacts)
         gdim = problem.u.function_space.mesh.geometry.dim
         #: "direct" or "iterative", as chosen for this problem
-        current = any(term.basis_configuration == "current" for term in problem.contacts)
         self.linear_solver = choose_linear_solver(linear_solver, problem.num_dofs, gdim,
-                                                  augmented, current)
+                                                  augmented, self.current)
         #: the iterative path's preconditioner, once made
         self.preconditioner: Optional[ContactBlockPreconditioner] = None
         self.petsc_options = dict(petsc_options or {})
@@ -75,8 +79,8 @@ class LoadPathSolver:
         self._user_options: dict[str, bool] = {}
         #: wall time (s) inside SNES solves, callbacks included (accumulated)
         self.timings: dict[str, float] = {}
-        #: the current-surface phase's line search of the last :meth:`create_snes`
-        #: (None where the library does not choose it: :meth:`library_line_search`)
+        #: the line search of the last :meth:`create_snes` (None where the user
+        #: chose one: :meth:`library_line_search`)
         self.line_search: Optional[FullStepFirst] = None
 
     @property
@@ -87,8 +91,7 @@ class LoadPathSolver:
         """The solver's defaults (:data:`DEFAULT_OPTIONS`), with the iterative
         linear solver's options where it was chosen.
 
-        The line search is ``basic``. On the current surface
-        (``basis_configuration="current"``) it runs
+        The line search is ``basic`` with
         :class:`~dolfinx_mortar.solver.line_search.FullStepFirst` as its
         pre-check, unless the user chose a line search (:meth:`library_line_search`).
         """
@@ -118,7 +121,7 @@ class LoadPathSolver:
         self.problem.configure_snes(snes)
         snes.setConvergenceHistory()
         self._configure_from_options(snes)
-        self.line_search = (FullStepFirst(self.problem, snes)
+        self.line_search = (FullStepFirst(self.problem, snes, shorten=self.shortens_frozen_steps)
                             if self.library_line_search() else None)
         if self.line_search is not None:
             self.line_search.attach()
@@ -133,17 +136,38 @@ class LoadPathSolver:
         self.problem.configure_ksp(snes.getKSP())
 
     def library_line_search(self) -> bool:
-        """Whether the current-surface phase of a ``"current"`` step takes the
-        library's line search (:class:`~dolfinx_mortar.solver.line_search.FullStepFirst`):
-        a term uses the current configuration and the user set no
-        ``snes_linesearch_type``. The frozen phase keeps ``basic``: it is the
-        piecewise-linear "previous" model, where ``l2`` only slowed the active
-        set down (Hertz 3D with two bodies, iterative linear solver, 33 against
-        13 Newton iterations at 30k dofs and 31 against 11 at 52k)."""
-        if not any(term.basis_configuration == "current" for term in self.contacts):
-            return False
+        """Whether the library's line search
+        (:class:`~dolfinx_mortar.solver.line_search.FullStepFirst`) runs: the
+        user set no ``snes_linesearch_type``.
+
+        It halves steps whose residual is not finite (a finite-strain law past
+        J = 0) in every phase, and shortens full steps that do not lower
+        ``‖F‖`` to ``l2``'s length on the current surface (the second phase of
+        a ``"current"`` step) and, for a bulk law that is nonlinear in u, in
+        every phase (:attr:`shortens_frozen_steps`).
+        """
         key = "snes_linesearch_type"
         return not (key in self.petsc_options or self._user_options.get(key, False))
+
+    @property
+    def shortens_frozen_steps(self) -> bool:
+        """Whether the line search shortens steps on frozen surfaces too: the
+        bulk residual is nonlinear in u.
+
+        A frozen surface is the piecewise-linear "previous" model. With a
+        linear bulk, shortened steps only slowed the active set down (Newton
+        iterations, full steps against shortened ones: Hertz 2D 22 against 28,
+        with an elastic block 23/33, Hertz 3D 16/24); a neo-Hookean bulk
+        needs them (a disk pressed into a block and slid sideways, 12 steps
+        requested: 12 steps and no cut-back against 24 steps and 7
+        cut-backs; ironing 2D 800 against 1387 Newton iterations).
+        """
+        return not self.problem.bulk_is_linear
+
+    @property
+    def current(self) -> bool:
+        """Whether a contact term uses the current configuration (two phases per step)."""
+        return any(term.basis_configuration == "current" for term in self.contacts)
 
     def _configure_preconditioner(self, ksp: PETSc.KSP) -> None:
         """The contact-block preconditioner for ``pc_type python`` (the
@@ -195,6 +219,8 @@ class LoadPathSolver:
         writer = ContactOutput(Path(output), u, self.contacts) if output is not None else None
         result = SolveResult()
         failures: list[FailedAttempt] = []
+        # each term's deepest penetration over the converged steps (warned about at the end)
+        deepest = [(-np.inf, 0.0, [])] * len(self.contacts)
         path = PathExtrapolation() if predictor == "linear" else None
         bar = None
         if progress and self.comm.rank == 0:
@@ -221,10 +247,16 @@ class LoadPathSolver:
                         snes, x, increment)
                     history = [r for phase in phases for r in phase]
                     if reason <= 0:
-                        failures.append(FailedAttempt(target, reason, history, cause))
+                        attempt = FailedAttempt(target, reason, history, cause)
+                        failures.append(attempt)
                         stepper.failed()
                         if stepper.exhausted:
                             raise ContactDivergenceError(target, failures)
+                        result.cut_backs.append(attempt)
+                        if self.comm.rank == 0:
+                            logger.warning("load step to t = %.6g failed after %d Newton "
+                                           "iterations (%s); cut back to t = %.6g",
+                                           target, iterations, cause, stepper.target())
                         saved.copy(u.x.petsc_vec)
                         u.x.scatter_forward()
                         continue
@@ -234,6 +266,8 @@ class LoadPathSolver:
                     if path is not None:
                         path.converged(target, u.x.petsc_vec)
                     states = [term.evaluate() for term in self.contacts]
+                    deepest = [max(worst, term.penetration(state), key=lambda d: d[0])
+                               for worst, term, state in zip(deepest, self.contacts, states)]
                     active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
                     step = StepResult(target, iterations, history,
                                       time.perf_counter() - clock, active, phases, reference,
@@ -250,6 +284,8 @@ class LoadPathSolver:
                         writer.write(target, states)
                     if on_step is not None:
                         on_step(step)
+                for term, worst in zip(self.contacts, deepest):
+                    term.warn_if_the_penalty_is_low(worst)
             finally:
                 if bar is not None:
                     bar.close()
@@ -284,16 +320,36 @@ class LoadPathSolver:
         self.equilibrium.start(reference)
         if increment is not None:
             x.axpy(1.0, increment)
-        two_phase = any(term.basis_configuration == "current" for term in self.contacts)
-        for frozen in ([True, False] if two_phase else [False]):
+            self.problem.F(x, b)
+            if not math.isfinite(b.norm()):
+                # the extrapolation left the law's domain (J ≤ 0 under ln J) or
+                # collapsed a surface: start from the last converged state
+                x.axpy(-1.0, increment)
+        for frozen in ([True, False] if self.current else [False]):
             reason = self._solve_phase(snes, x, frozen)
             phases.append([float(r) for r in snes.getConvergenceHistory()[0]])
             iterations += snes.getIterationNumber()
             linear += snes.getLinearSolveIterations()
             if reason <= 0:
-                return (reason, phases, iterations,
-                        describe_failure(snes, self.equilibrium), reference, linear)
+                cause = describe_failure(snes, self.equilibrium, self.problem.evaluation_error)
+                return reason, phases, iterations, cause + self._contact_hint(), reference, linear
         return reason, phases, iterations, "", reference, linear
+
+    def _contact_hint(self) -> str:
+        """What the contact says about a failed Newton solve, from its state at
+        the last iterate: nothing touching means a body that only the contact
+        holds has no stiffness (collective)."""
+        if self.problem.evaluation_error is not None:
+            return ""
+        # u holds the last iterate; the frozen phase's states are gone with its model
+        states = [term.state if term.state is not None else term.evaluate()
+                  for term in self.contacts]
+        if sum(term.active_nodes(state) for term, state in zip(self.contacts, states)) > 0:
+            return ""
+        return ("; no slave node was in contact at the last iterate: if only the contact "
+                "holds the body, the load pulls it away from the master or obstacle, or "
+                "nothing is within reach (check the load's sign, which surface is the "
+                "slave and which the master, and the obstacle's position)")
 
     def _solve_phase(self, snes: PETSc.SNES, x: PETSc.Vec, frozen: bool) -> int:
         from contextlib import ExitStack
@@ -301,8 +357,8 @@ class LoadPathSolver:
             if frozen:
                 for term in self.contacts:
                     stack.enter_context(term.frozen())
-            if frozen and self.line_search is not None:
-                stack.enter_context(self.line_search.suspended())
+            if frozen and self.line_search is not None and not self.shortens_frozen_steps:
+                stack.enter_context(self.line_search.full_steps_only())
             close_gaps(self.problem, snes.getKSP(), x)
             snes.setConvergenceHistory(reset=True)
             clock = time.perf_counter()

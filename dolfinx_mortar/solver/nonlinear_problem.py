@@ -23,11 +23,13 @@ from typing import Optional, Sequence, Union
 
 import numpy as np
 import ufl
+from ufl.algorithms import expand_derivatives
 from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
@@ -85,6 +87,10 @@ class NonlinearContactProblem:
         if J is None:
             J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
         self.a = fem.form(J, form_compiler_options=fc, jit_options=jit)
+        #: whether the bulk residual is linear in u (its Jacobian does not depend
+        #: on u): the load path's line search shortens frozen-phase steps only
+        #: for a nonlinear bulk (:meth:`LoadPathSolver.library_line_search`)
+        self.bulk_is_linear = u not in expand_derivatives(J).coefficients()
         self._A: Optional[PETSc.Mat] = None
         self._b: Optional[PETSc.Vec] = None
         self._near_nullspace: Optional[PETSc.NullSpace] = None
@@ -95,6 +101,8 @@ class NonlinearContactProblem:
         self.timings: dict[str, float] = {}
         #: a residual evaluated ahead, for the next :meth:`F` (see :meth:`offer_residual`)
         self._offered: Optional[tuple[np.ndarray, PETSc.Vec]] = None
+        #: why the last :meth:`F` could not be evaluated (its residual is NaN), or None
+        self.evaluation_error: Optional[str] = None
 
     # -- what NewtonSolver and SNES call -----------------------------------------------
     def form(self, x: PETSc.Vec) -> None:
@@ -127,8 +135,15 @@ class NonlinearContactProblem:
         return same
 
     def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
-        """Assemble the residual at ``x`` into ``b`` (the contact states are updated)."""
+        """Assemble the residual at ``x`` into ``b`` (the contact states are updated).
+
+        Where the contact surfaces have collapsed at ``x``
+        (:class:`~dolfinx_mortar.errors.DegenerateGeometryError`, on every rank
+        together) ``b`` is NaN and :attr:`evaluation_error` says why: SNES sees
+        a failed trial point, not an exception inside its callback.
+        """
         clock = time.perf_counter()
+        self.evaluation_error = None
         if x.handle != self.u.x.petsc_vec.handle:
             x.copy(self.u.x.petsc_vec)
         self.u.x.petsc_vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
@@ -145,8 +160,14 @@ class NonlinearContactProblem:
         fem_petsc.apply_lifting(b, [self.a], [self.bcs], x0=[self.u.x.petsc_vec], alpha=-1.0)
         b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         self._add("bulk_residual", clock)
-        for term in self.contacts:
-            term.assemble_residual(b, self.bcs)
+        try:
+            for term in self.contacts:
+                term.assemble_residual(b, self.bcs)
+        except DegenerateGeometryError as error:
+            self.evaluation_error = str(error)
+            with b.localForm() as local:
+                local.set(np.nan)
+            return
         fem_petsc.set_bc(b, self.bcs, self.u.x.petsc_vec, -1.0)
 
     def J(self, x: PETSc.Vec, A: PETSc.Mat, ksp: Optional[PETSc.KSP] = None) -> None:

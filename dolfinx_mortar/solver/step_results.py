@@ -38,9 +38,13 @@ class StepResult:
 
 @dataclass
 class SolveResult:
-    """All converged steps."""
+    """All converged steps, and every attempt that failed and was cut back."""
 
     steps: list = field(default_factory=list)
+    #: one :class:`~dolfinx_mortar.solver.convergence.FailedAttempt` (load
+    #: factor, SNES reason, residual norms, cause in words) per failed attempt
+    #: after which the step was halved and retried, in the order they happened
+    cut_backs: list = field(default_factory=list)
 
     @property
     def newton_iterations(self) -> int:

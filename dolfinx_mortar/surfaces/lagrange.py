@@ -13,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from dolfinx_mortar import _kernels
+from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.layout import NodeLayout
 from dolfinx_mortar.surfaces.tabulation import Tabulation
 from dolfinx_mortar.tolerance import GEOMETRIC_TOLERANCE, length_scale, zero_length
@@ -225,7 +226,14 @@ class LagrangeSurface:
             raise ValueError(f"axisymmetric surface with a node at r = {r_min:.6g} < 0: the "
                              "(r, z) mesh must lie in r ≥ 0 (x is the radius, y the axis)")
 
-    def _check_degenerate_cells(self) -> None:
+    def check_displaced(self, displacement: FloatArray) -> None:
+        """Raise :class:`~dolfinx_mortar.errors.DegenerateGeometryError` on every
+        rank if the surface displaced by ``displacement`` (local nodes, gdim)
+        has a degenerate cell, as :meth:`moved` would, without making it
+        (collective)."""
+        self._check_degenerate_cells(self.x + displacement)
+
+    def _check_degenerate_cells(self, x: Optional[FloatArray] = None) -> None:
         """Refuse facets of zero size, and triangles or quadrilaterals of zero
         height (collinear vertices), judged against the geometry's scale.
 
@@ -235,16 +243,17 @@ class LagrangeSurface:
         singular factorization with no hint at the mesh.
         """
         comm = self.layout.comm
-        message = self._degenerate_cells_message() if len(self.cells) else None
+        x = self.x if x is None else x
+        message = self._degenerate_cells_message(x) if len(self.cells) else None
         # every rank raises, so that none waits in a collective for the other
         messages = [m for m in comm.allgather(message) if m] if comm.size > 1 else [message]
         if messages and messages[0]:
-            raise ValueError(messages[0])
+            raise DegenerateGeometryError(messages[0])
 
-    def _degenerate_cells_message(self) -> Optional[str]:
+    def _degenerate_cells_message(self, x: FloatArray) -> Optional[str]:
         nv = {"interval": 2, "triangle": 3, "quadrilateral": 4}[self.reference.cell]
-        vertices = self.x[self.cells[:, :nv]]                      # (cells, nv, gdim)
-        zero = zero_length(length_scale(self.x))
+        vertices = x[self.cells[:, :nv]]                           # (cells, nv, gdim)
+        zero = zero_length(length_scale(x))
         offsets = vertices[:, :, None, :] - vertices[:, None, :, :]
         size = np.linalg.norm(offsets, axis=-1).max(axis=(1, 2))  # largest vertex distance
         bad = size <= zero

@@ -26,9 +26,9 @@ FORCE_TOLERANCE = 1e-4
 OPEN = {
     ("GLS", "pointwise", "initial"): "pressures 2.2e-3 off (1.9e-2 at n = 40)",
     ("GLS*", "pointwise", "initial"): "pressures 2.2e-3 off (1.9e-2 at n = 40)",
-    ("LcLS*", "nodal", "current"): "PETSc error inside the SNES callback at n = 20 and 40",
-    ("LcLS", "nodal", "current"): "PETSc error inside the SNES callback at n = 20 and 40",
 }
+#: refused where the term is made: false penetration at u = 0 (test below)
+REFUSED = {("LcLS*", "nodal", "current"), ("LcLS", "nodal", "current")}
 
 
 def combinations() -> list:
@@ -38,6 +38,8 @@ def combinations() -> list:
             for configuration in ("initial", "previous", "current"):
                 if is_global(kind) and configuration == "current":
                     continue   # refused (test below)
+                if (kind, active_set, configuration) in REFUSED:
+                    continue
                 reason = OPEN.get((kind, active_set, configuration))
                 marks = [pytest.mark.xfail(strict=True, reason=f"OPEN (issue 26): {reason}")
                          ] if reason else []
@@ -64,6 +66,18 @@ def test_two_bodies_in_plane_strain_match_the_mirror(kind, active_set, configura
 def test_the_global_kinds_are_refused_in_the_current_configuration(kind):
     with pytest.raises(NotImplementedError, match="couples every slave facet"):
         mirror(6, PRESSED, penalty=6e3, kind=kind, basis_configuration="current")
+
+
+@pytest.mark.parametrize("kind", ["LcLS*", "LcLS"])
+def test_dual_kinds_on_the_current_surface_refuse_a_false_penetration(kind):
+    """The two bodies at u = 0 touch at one point; on the current surface a
+    dual kind read a penetration of 0.009 R at a node
+    whose element the search radius cuts, and Newton diverged until a
+    degenerate facet escaped from inside the SNES callback. The term refuses
+    the combination where it is made, saying why and what to use instead."""
+    with pytest.raises(NotImplementedError, match="false penetration at 1 slave node") as err:
+        mirror(20, PRESSED, penalty=2e4, kind=kind, basis_configuration="current")
+    assert "LmLS*" in str(err.value) and "previous" in str(err.value)
 
 
 @pytest.mark.parametrize("configuration", ["initial", "previous"])

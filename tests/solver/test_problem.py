@@ -1,6 +1,8 @@
 """The contact solver: patch tests, Hertz 2D, the Jacobian, bad input, output, MPI."""
 from __future__ import annotations
 
+import logging
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -208,9 +210,10 @@ class FailsOnceAt(ContactProblem):
             self.load.value = np.nan
 
 
-def test_a_cut_step_grows_back():
+def test_a_cut_step_grows_back(caplog):
     """The step to 5/6 fails and is halved; two steps later the step is 1/6
-    again, and the path ends where the uncut one does. (Until 2026-11-25 the
+    again, and the path ends where the uncut one does. The cut-back is logged
+    (one warning, on rank 0) and recorded in the result. (Until 2026-11-25 the
     failure was Newton needing 5 iterations with snes_max_it 4; at rtol·F ≈
     5e-15 for this scene that count was decided by round-off, and on 2 ranks
     of another CPU the 4/6 step converged in 2 and the path differed.)"""
@@ -218,8 +221,17 @@ def test_a_cut_step_grows_back():
     common = dict(obstacle=RigidSphere([0.5, -3.0], 3.0), E=1.0, nu=0.3, kind="LcLS*",
                   penalty=100.0, fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]})
     problem = FailsOnceAt(V, tags, 1, **common)
-    result = problem.solve(load_steps=6)
+    with caplog.at_level(logging.WARNING, logger="dolfinx_mortar"):
+        result = problem.solve(load_steps=6)
     loads = [s.load_factor for s in result.steps]
+    [cut] = result.cut_backs
+    assert cut.load_factor == pytest.approx(5 / 6) and "NaN" in cut.cause
+    logged = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    if MPI.COMM_WORLD.rank == 0:
+        [message] = logged
+        assert "t = 0.833333 failed" in message and "cut back to t = 0.75" in message
+    else:
+        assert logged == []
     # halved to the end this was 8 steps: ..., 0.75, 0.8333, 0.9167, 1
     assert loads == pytest.approx([1 / 6, 2 / 6, 3 / 6, 4 / 6, 0.75, 5 / 6, 1.0])
     assert loads[-1] == 1.0
@@ -496,3 +508,42 @@ def test_gls_first_touch_starts_from_the_closed_gap(kind):
     assert result.steps[0].load_factor == 0.5 and result.steps[0].newton_iterations <= 6
     assert result.steps[-1].load_factor == 1.0 and problem.normal_force() > 0
     assert max(attempts) <= 15, attempts   # cycles of period 2 and 3 ran to 40
+
+
+def test_a_low_penalty_is_warned_about_with_a_penalty_that_works():
+    """A block pushed onto a rigid plane by a traction of 0.01 (h = 1/8):
+    with ε = 1 it penetrates by 0.01, 8% of an element, and that passed
+    without a word. It is warned about once, naming a penalty; with that
+    penalty the penetration is the 1e-3 element lengths it aims at (the force
+    is prescribed: the penetration is p/ε), and nothing is warned."""
+    V, tags = block_on_plane()
+    common = dict(obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3, kind="LcLS*",
+                  fixed={3: {0: 0.0}}, tractions={2: [0.0, -0.01]})
+    low = ContactProblem(V, tags, 1, penalty=1.0, **common)
+    with pytest.warns(RuntimeWarning, match="the penalty 1 is low for this mesh") as record:
+        low.solve(load_steps=2)
+    [warning] = [w for w in record if "penalty" in str(w.message)]
+    suggested = float(str(warning.message).split("about ")[1].split(" would")[0])
+    assert suggested == pytest.approx(80.0, rel=0.05)
+    good = ContactProblem(V, tags, 1, penalty=suggested, **common)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        good.solve(load_steps=2)
+    depth = MPI.COMM_WORLD.allreduce(float(np.max(good.nodal_pressures(), initial=0.0)),
+                                     op=MPI.MAX) / suggested
+    assert depth * 8 == pytest.approx(1e-3, rel=0.05)
+
+
+def test_a_body_pulled_off_its_only_support_says_so():
+    """A block held sideways only, pushed onto a rigid plane by its top
+    traction's opposite: pulled away, nothing holds it vertically. Newton
+    stalled and said "e.g. a penalty far above E/h"; the failure now says that
+    nothing was in contact and what to check."""
+    V, tags = block_on_plane()
+    problem = ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
+                             kind="LcLS*", penalty=1e2, fixed={3: {0: 0.0}},
+                             tractions={2: [0.0, 0.01]})
+    with pytest.raises(ContactDivergenceError) as err:
+        problem.solve(load_steps=1, max_cuts=1)
+    assert all("no slave node was in contact at the last iterate" in attempt.cause
+               for attempt in err.value.history), err.value

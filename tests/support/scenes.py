@@ -103,3 +103,48 @@ def sheared_boxes(kind: str, scaling: str = "consistent",
                           cells0=cells[height < 0])
     problem.u.x.scatter_forward()
     return problem
+
+
+#: the gap between the blocks of :func:`overhanging_blocks`
+OVERHANG_GAP = 0.05
+
+
+def overhanging_blocks(comm=MPI.COMM_WORLD):
+    """A wide lower block [0,1]×[−½,0] and a narrower upper block
+    [0.23,0.73]×[OVERHANG_GAP,½] above it: the master (upper bottom) ends inside slave
+    facets (lower top). Tags: 1 slave, 2 master, 3 lower bottom, 4 upper top,
+    5 upper left."""
+    import gmsh
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
+    gmsh.initialize(["", "-v", "0"])
+    try:
+        if comm.rank == 0:
+            occ = gmsh.model.occ
+            lower = occ.addRectangle(0, -0.5, 0, 1, 0.5)
+            upper = occ.addRectangle(0.23, OVERHANG_GAP, 0, 0.5, 0.5 - OVERHANG_GAP)
+            occ.synchronize()
+            groups = {k: [] for k in range(1, 6)}
+            for body in (lower, upper):
+                for _, c in gmsh.model.getBoundary([(2, body)], oriented=False):
+                    x, y, _ = occ.getCenterOfMass(1, c)
+                    if abs(y) < 1e-9:
+                        groups[1].append(c)
+                    elif abs(y - OVERHANG_GAP) < 1e-9:
+                        groups[2].append(c)
+                    elif abs(y + 0.5) < 1e-9:
+                        groups[3].append(c)
+                    elif abs(y - 0.5) < 1e-9:
+                        groups[4].append(c)
+                    elif abs(x - 0.23) < 1e-9:
+                        groups[5].append(c)
+            for tag, curves in groups.items():
+                gmsh.model.addPhysicalGroup(1, curves, tag)
+            gmsh.model.addPhysicalGroup(2, [lower], 11)
+            gmsh.model.addPhysicalGroup(2, [upper], 12)
+            gmsh.model.mesh.setSize(gmsh.model.getBoundary([(2, lower)], recursive=True), 0.09)
+            gmsh.model.mesh.setSize(gmsh.model.getBoundary([(2, upper)], recursive=True), 0.13)
+            gmsh.model.mesh.generate(2)
+        domain, _, tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
+    finally:
+        gmsh.finalize()
+    return fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,))), tags
