@@ -24,7 +24,6 @@ import time
 from typing import Optional, Sequence
 
 import numpy as np
-import ufl
 from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -32,6 +31,7 @@ from petsc4py import PETSc
 from dolfinx_mortar import (ContactDivergenceError, ContactTerm, LoadPathSolver,
                             NonlinearContactProblem, RigidSphere)
 from demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
+from demo_support.laws import neo_hookean_residual
 from dolfinx_mortar.io.output import save_figure, write_csv, write_json
 
 TOP, BOTTOM = 1, 2
@@ -141,18 +141,6 @@ def build_mesh(args: argparse.Namespace, comm: MPI.Comm):
     finally:
         gmsh.finalize()
     return domain, facet_tags, h
-
-
-def neo_hookean_residual(u: fem.Function, E: float, nu: float) -> ufl.Form:
-    """The first variation of the compressible neo-Hookean energy (plane strain)
-    ``ψ = μ/2 (tr C − 2) − μ ln J + λ/2 (ln J)²``."""
-    v = ufl.TestFunction(u.function_space)
-    d = len(u)
-    F = ufl.Identity(d) + ufl.grad(u)
-    J = ufl.det(F)
-    mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
-    psi = mu / 2 * (ufl.tr(F.T * F) - d) - mu * ufl.ln(J) + lmbda / 2 * ufl.ln(J) ** 2
-    return ufl.derivative(psi * ufl.dx, u, v)
 
 
 def load_path(args: argparse.Namespace, cylinder: RigidSphere):

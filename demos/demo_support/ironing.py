@@ -18,7 +18,6 @@ import argparse
 import time
 
 import numpy as np
-import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
@@ -27,6 +26,7 @@ from petsc4py import PETSc
 from dolfinx_mortar import (ContactDivergenceError, ContactTerm, LoadPathSolver,
                             NonlinearContactProblem)
 from demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
+from demo_support.laws import neo_hookean_residual
 from dolfinx_mortar.io.output import save_figure, write_csv, write_json
 
 #: facet tags
@@ -165,18 +165,6 @@ def build_mesh(args: argparse.Namespace, comm: MPI.Comm):
         gmsh.finalize()
     return domain, cell_tags, facet_tags
 
-
-
-def neo_hookean_residual(u: fem.Function, E, nu: float) -> ufl.Form:
-    """The first variation of ``ψ = μ/2 (tr C − d) − μ ln J + λ/2 (ln J)²``
-    (plane strain in 2D); ``E`` may vary over the cells."""
-    v = ufl.TestFunction(u.function_space)
-    d = len(u)
-    F = ufl.Identity(d) + ufl.grad(u)
-    J = ufl.det(F)
-    mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
-    psi = mu / 2 * (ufl.tr(F.T * F) - d) - mu * ufl.ln(J) + lmbda / 2 * ufl.ln(J) ** 2
-    return ufl.derivative(psi * ufl.dx, u, v)
 
 
 def die_motion(args: argparse.Namespace):

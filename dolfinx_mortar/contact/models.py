@@ -135,7 +135,7 @@ def moved(u_nodes: FloatArray, since: Optional[FloatArray], comm: MPI.Comm) -> b
 
 def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
                              master: Optional[LagrangeSurface], current: GapModel, u,
-                             u_nodes: FloatArray) -> None:
+                             u_nodes: FloatArray) -> Optional[MortarCoupling]:
     """Refuse a dual kind on the current surface against an elastic master
     where it reads a penetration that is not there (NotImplementedError).
 
@@ -151,11 +151,12 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     is made, with the modified ones of the frozen model: a node that only the
     current surface sees penetrating stops the construction, with the way
     out. A master that covers the slave's elements in full (a cylinder on a
-    wider block) passes.
+    wider block) passes. Returns the frozen model's coupling where it was made
+    (None elsewhere), for the term's other checks.
     """
     if not (options.basis_configuration == "current" and master is not None
             and options.kind in DUAL_KINDS and options.active_set == "nodal"):
-        return
+        return None
     frozen = replace(options, basis_configuration="previous", boundary_modification=True)
     modified = frozen_model(frozen, slave, master, None, u_nodes, u.x.petsc_vec.copy())
     owned = slave.layout.num_owned
@@ -168,7 +169,7 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
                            op=MPI.MAXLOC)
     count = comm.allreduce(int(false.sum()))
     if count == 0:
-        return
+        return modified.coupling
     where = ""
     if comm.rank == worst[1]:
         node = int(np.flatnonzero(false)[np.argmax(gaps[false])])

@@ -291,8 +291,7 @@ class ContactResults:
                           "use basis_configuration='previous' or 'current'",
                           RuntimeWarning, stacklevel=3)
 
-
-    def warn_if_no_master_is_in_reach(self) -> None:
+    def warn_if_no_master_is_in_reach(self, coupling: Optional[MortarCoupling] = None) -> None:
         """Against an elastic master, warn when no slave facet finds a master
         facet within the search radius, saying whether the master faces away.
 
@@ -301,13 +300,14 @@ class ContactResults:
         as the slave's (the far side of the other body, or tags swapped) is
         never paired, since only opposing facets are; a master beyond the
         search radius is not paired either, and in the initial configuration
-        it never will be.
+        it never will be. ``coupling``: a segmentation of this configuration
+        already made (the model's is used where it has one).
         """
         if self.master is None:
             return
         comm = self.mesh.comm
         radius = self.options.search_radius
-        coupling = getattr(self.model, "coupling", None)
+        coupling = getattr(self.model, "coupling", coupling)
         if coupling is None:        # the current surface: one segmentation for this check
             coupling = MortarCoupling(self.slave, self.master, search_radius=radius)
         if comm.allreduce(len(coupling.pairs)) > 0:
@@ -332,18 +332,20 @@ class ContactResults:
                       "the bodies' positions, or pass a larger search_radius", RuntimeWarning,
                       stacklevel=3)
 
-    def warn_if_contact_reached_the_search_radius(
-            self, state: Optional[ContactState] = None) -> None:
-        """With bases frozen against an elastic master: warn (once) when the contact zone
-        reaches slave nodes that found no master within the search radius, though a master
-        lies beyond it. The pairs are found once per frozen configuration, along the normal
-        and within the search radius (the largest slave facet by default); where the
-        surfaces were further apart then, the pressure is cut off, with a peak at the last
-        paired node. Two equal cylinders with a = R/10 on a mesh graded to h = a/40 lost
-        the outer fifth of the contact zone that way and had the pressure 51% off."""
-        if (self.master is None or self.basis_configuration == "current"
-                or getattr(self, "_radius_warned", False)):
-            return
+    def contact_reached_the_search_radius(self, state: Optional[ContactState] = None) -> bool:
+        """With bases frozen against an elastic master: whether the contact zone
+        reaches slave nodes that found no master within the search radius, though
+        a master lies within four times it (collective).
+
+        The pairs are found once per frozen configuration, along the normal and
+        within the search radius (the largest slave facet by default); where the
+        surfaces were further apart then, the pressure is cut off, with a peak
+        at the last paired node. Two equal cylinders with a = R/10 on a mesh
+        graded to h = a/40 lost the outer fifth of the contact zone that way and
+        had the pressure 51% off.
+        """
+        if self.master is None or self.basis_configuration == "current":
+            return False
         model, slave = self.model, self.slave
         comm = self.mesh.comm
         covered = model.covered
@@ -353,7 +355,7 @@ class ContactResults:
         at_edge = (active[cells].any(axis=1) & ~covered[cells].all(axis=1)
                    if len(cells) else np.zeros(0, dtype=bool))
         if not comm.allreduce(bool(at_edge.any()), op=MPI.LOR):
-            return
+            return False
         coupling = model.coupling
         cached = getattr(self, "_beyond_radius", None)
         if cached is None or cached[0] is not coupling:
@@ -365,14 +367,7 @@ class ContactResults:
         reached = cached[1] & ~covered
         near_edge = np.zeros(slave.layout.size_local, dtype=bool)
         near_edge[cells[at_edge].ravel()] = True
-        if comm.allreduce(bool(np.any(reached & near_edge)), op=MPI.LOR):
-            self._radius_warned = True
-            r = coupling.search_radius
-            warnings.warn(f"the contact zone reached slave nodes that found no master within "
-                          f"the search radius {r:.3g}, though a master lies beyond it: the "
-                          f"pressure is cut off there. Pass a larger search_radius (e.g. "
-                          f"{4 * r:.3g}) or basis_configuration='previous'",
-                          RuntimeWarning, stacklevel=3)
+        return bool(comm.allreduce(bool(np.any(reached & near_edge)), op=MPI.LOR))
 
 
 def _gather_entries(vec: PETSc.Vec, indices: npt.NDArray) -> FloatArray:

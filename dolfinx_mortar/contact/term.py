@@ -17,8 +17,11 @@ does exactly this around the user's residual form.
 """
 from __future__ import annotations
 
+import logging
 import time
+import warnings
 from contextlib import contextmanager
+from dataclasses import replace
 from typing import Iterator, Optional, Sequence
 
 import numpy as np
@@ -42,6 +45,10 @@ from dolfinx_mortar.input_checks import check_cells, check_contact_tags
 from dolfinx_mortar.surfaces.facet_surface import facet_surface, nodal_displacement
 
 FloatArray = npt.NDArray[np.float64]
+logger = logging.getLogger(__name__)
+#: how many times a default search radius is widened (×4 each) before the
+#: contact zone's reaching it is only warned about
+MAX_RADIUS_WIDENINGS = 3
 SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
 DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 
@@ -151,10 +158,10 @@ class ContactTerm(ContactResults):
         #: stiffened (:meth:`assemble_jacobian`)
         self.stiffened_rows: np.ndarray = np.zeros(0, dtype=PETSc.IntType)
         self.model: GapModel = self._build(None)
-        refuse_false_penetration(self.options, self.slave, self.master, self.model, u,
-                                 nodal_displacement(self.slave, u))
+        frozen = refuse_false_penetration(self.options, self.slave, self.master, self.model,
+                                          u, nodal_displacement(self.slave, u))
         self.warn_deep_initial_penetration()
-        self.warn_if_no_master_is_in_reach()
+        self.warn_if_no_master_is_in_reach(frozen)
 
     # -- configuration ---------------------------------------------------------------
     @property
@@ -188,6 +195,37 @@ class ContactTerm(ContactResults):
             return False
         self.model = self._build(u_nodes)
         return True
+
+    def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:
+        """Called by a load-path driver after a converged step: where the contact
+        zone reached slave nodes that found no master within the search radius
+        though one lies beyond it (:meth:`contact_reached_the_search_radius`),
+        rebuild the frozen bases with four times the radius and return True (the
+        step must be solved again, with a new matrix pattern). A radius the user
+        gave is kept, with a warning; so is one already widened
+        MAX_RADIUS_WIDENINGS times (collective)."""
+        if getattr(self, "_radius_warned", False) or not (
+                self.contact_reached_the_search_radius(state)):
+            return False
+        radius = self.model.coupling.search_radius
+        widenings = getattr(self, "_radius_widenings", 0)
+        if self.options.search_radius is None or widenings > 0:
+            if widenings < MAX_RADIUS_WIDENINGS:
+                self._radius_widenings = widenings + 1
+                self.options = replace(self.options, search_radius=4 * radius)
+                self.model = self._build(self._built_at)
+                if self.mesh.comm.rank == 0:
+                    logger.info("the contact zone reached slave nodes with no master within "
+                                "the search radius %.3g: bases rebuilt with %.3g, step "
+                                "solved again", radius, 4 * radius)
+                return True
+        self._radius_warned = True
+        warnings.warn(f"the contact zone reached slave nodes that found no master within "
+                      f"the search radius {radius:.3g}, though a master lies beyond it: the "
+                      f"pressure is cut off there. Pass a larger search_radius (e.g. "
+                      f"{4 * radius:.3g}) or basis_configuration='previous'",
+                      RuntimeWarning, stacklevel=3)
+        return False
 
     @contextmanager
     def frozen(self) -> Iterator[None]:

@@ -121,7 +121,8 @@ class LoadPathSolver:
         self.problem.configure_snes(snes)
         snes.setConvergenceHistory()
         self._configure_from_options(snes)
-        self.line_search = (FullStepFirst(self.problem, snes, shorten=self.shortens_frozen_steps)
+        shorten = self.current or self.shortens_frozen_steps
+        self.line_search = (FullStepFirst(self.problem, snes, shorten=shorten)
                             if self.library_line_search() else None)
         if self.line_search is not None:
             self.line_search.attach()
@@ -263,9 +264,17 @@ class LoadPathSolver:
                     failures = []
                     x.copy(u.x.petsc_vec)
                     u.x.scatter_forward()
+                    states = [term.evaluate() for term in self.contacts]
+                    if any([term.widen_search_radius(state)
+                            for term, state in zip(self.contacts, states)]):
+                        # the bases were cut off by the search radius: the same step again
+                        saved.copy(u.x.petsc_vec)
+                        u.x.scatter_forward()
+                        snes.setJacobian(lambda _s, x, A, P: self.problem.J(x, A, _s.getKSP()),
+                                         self.problem.refresh_matrix())
+                        continue
                     if path is not None:
                         path.converged(target, u.x.petsc_vec)
-                    states = [term.evaluate() for term in self.contacts]
                     deepest = [max(worst, term.penetration(state), key=lambda d: d[0])
                                for worst, term, state in zip(deepest, self.contacts, states)]
                     active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
@@ -279,7 +288,6 @@ class LoadPathSolver:
                         bar.update(stepper.fraction_of_steps - before)
                     for term, state in zip(self.contacts, states):
                         term.warn_if_slipped_too_far(state)
-                        term.warn_if_contact_reached_the_search_radius(state)
                     if writer is not None:
                         writer.write(target, states)
                     if on_step is not None:
