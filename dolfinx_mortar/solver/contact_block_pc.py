@@ -130,6 +130,16 @@ class ContactBlockPreconditioner:
         viewer.printfASCII(f"contact block preconditioner: {self.block_size} rows solved "
                            f"exactly, multigrid ({self.amg.getPC().getType()}) for the rest\n")
 
+    def reset(self, pc: PETSc.PC) -> None:
+        """PCReset: the operator's nonzero pattern changed (the current
+        configuration's contact pairs moved). The multigrid must forget the
+        converted matrix it reuses: BoomerAMG set up again on the old
+        structure returned NaN at the first Krylov iteration (DOLFINx
+        0.9/0.11, PETSc 3.22/3.25)."""
+        for ksp in (self.amg, self.block):
+            if ksp is not None:
+                ksp.reset()
+
     def destroy(self, pc: PETSc.PC) -> None:
         for obj in (self.amg, self.block, self.rows, *self._work):
             if obj is not None:

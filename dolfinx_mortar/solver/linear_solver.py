@@ -13,8 +13,8 @@ preconditioned by multigrid plus an exact contact block.
     solved more accurately than they are worth.
 ``"auto"``
     ``"iterative"`` in 3D from :data:`ITERATIVE_FROM_DOFS` dofs on, ``"direct"``
-    otherwise and always for the GLS kinds and the current configuration (README,
-    "Linear solvers"; docs/SCALING.md).
+    otherwise and always for the GLS kinds (README, "Linear solvers";
+    docs/SCALING.md).
 
 Every option stays overridable under the solver's prefix
 (``-dolfinx_mortar_ksp_type``, ``-dolfinx_mortar_amg_pc_type gamg``, …).
@@ -60,20 +60,10 @@ def iterative_options(symmetric: bool) -> dict:
     }
 
 
-def choose_linear_solver(requested: str, num_dofs: int, gdim: int, augmented: bool,
-                         current: bool = False) -> str:
-    """``"direct"`` or ``"iterative"`` for a problem (see the module's text); ``current``:
-    a contact term works in the current configuration."""
+def choose_linear_solver(requested: str, num_dofs: int, gdim: int, augmented: bool) -> str:
+    """``"direct"`` or ``"iterative"`` for a problem (see the module's text)."""
     if requested not in LINEAR_SOLVERS:
         raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {requested!r}")
-    if current:
-        if requested == "iterative":
-            raise NotImplementedError(
-                "the iterative path fails in the current configuration with DOLFINx 0.9 and "
-                "0.11 (KSP DIVERGED_NANORINF at 0 iterations once the current phase starts, "
-                "Hertz 3D with two bodies; it worked with DOLFINx 0.5.2): use "
-                "linear_solver='direct' (docs/DOLFINX_VERSIONS.md, 'Open')")
-        return "direct"
     if augmented:
         if requested == "iterative":
             raise NotImplementedError(

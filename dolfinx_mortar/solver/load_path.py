@@ -36,6 +36,7 @@ from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOption
 from dolfinx_mortar.solver.step_results import SolveResult, StepResult
 
 logger = logging.getLogger(__name__)
+_SNES = PETSc.SNES.ConvergedReason
 
 
 class LoadPathSolver:
@@ -68,7 +69,7 @@ class LoadPathSolver:
         gdim = problem.u.function_space.mesh.geometry.dim
         #: "direct" or "iterative", as chosen for this problem
         self.linear_solver = choose_linear_solver(linear_solver, problem.num_dofs, gdim,
-                                                  augmented, self.current)
+                                                  augmented)
         #: the iterative path's preconditioner, once made
         self.preconditioner: Optional[ContactBlockPreconditioner] = None
         self.petsc_options = dict(petsc_options or {})
@@ -340,7 +341,10 @@ class LoadPathSolver:
             linear += snes.getLinearSolveIterations()
             if reason <= 0:
                 cause = describe_failure(snes, self.equilibrium, self.problem.evaluation_error)
-                return reason, phases, iterations, cause + self._contact_hint(), reference, linear
+                if self.equilibrium.cause is not None or reason == _SNES.DIVERGED_MAX_IT:
+                    # Newton ran and got nowhere (not a failed linear solve or residual)
+                    cause += self._contact_hint()
+                return reason, phases, iterations, cause, reference, linear
         return reason, phases, iterations, "", reference, linear
 
     def _contact_hint(self) -> str:

@@ -24,11 +24,6 @@ PRESSED = 0.02          # d: a contact half-width of about R/8
 PRESSURE_TOLERANCE = 1e-3
 FORCE_TOLERANCE = 1e-4
 
-#: (kind, active set, configuration) that do not match yet, with what they give at n = 20
-OPEN = {
-    ("GLS", "pointwise", "initial"): "pressures 2.2e-3 off (1.9e-2 at n = 40)",
-    ("GLS*", "pointwise", "initial"): "pressures 2.2e-3 off (1.9e-2 at n = 40)",
-}
 #: refused where the term is made: false penetration at u = 0 (test below)
 REFUSED = {("LcLS*", "nodal", "current"), ("LcLS", "nodal", "current")}
 
@@ -42,10 +37,7 @@ def combinations() -> list:
                     continue   # refused (test below)
                 if (kind, active_set, configuration) in REFUSED:
                     continue
-                reason = OPEN.get((kind, active_set, configuration))
-                marks = [pytest.mark.xfail(strict=True, reason=f"OPEN (issue 26): {reason}")
-                         ] if reason else []
-                params.append(pytest.param(kind, active_set, configuration, marks=marks,
+                params.append(pytest.param(kind, active_set, configuration,
                                            id=f"{kind}-{active_set}-{configuration}"))
     return params
 
