@@ -32,6 +32,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
+from dolfinx_mortar.solver.line_search import FullStepFirst
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 
 
@@ -103,6 +104,8 @@ class NonlinearContactProblem:
         self._offered: Optional[tuple[np.ndarray, PETSc.Vec]] = None
         #: why the last :meth:`F` could not be evaluated (its residual is NaN), or None
         self.evaluation_error: Optional[str] = None
+        #: the library's line search of :attr:`solver` (None where the user chose one)
+        self.line_search: Optional[FullStepFirst] = None
 
     # -- what NewtonSolver and SNES call -----------------------------------------------
     def form(self, x: PETSc.Vec) -> None:
@@ -255,12 +258,20 @@ class NonlinearContactProblem:
             snes.setOptionsPrefix(self.petsc_options_prefix)
             self.configure_snes(snes)
             db = PETSc.Options()
+            key = "snes_linesearch_type"
+            chosen = key in self.petsc_options or db.hasName(self.petsc_options_prefix + key)
             options = {key: value for key, value in DEFAULT_OPTIONS.items()
                        if not db.hasName(self.petsc_options_prefix + key)}
             options.update(self.petsc_options)
             with TemporaryOptions(self.petsc_options_prefix, options):
                 snes.setFromOptions()
                 self.configure_ksp(snes.getKSP())
+            if not chosen:
+                # the load path's line search, as LoadPathSolver has it
+                current = any(t.basis_configuration == "current" for t in self.contacts)
+                self.line_search = FullStepFirst(self, snes,
+                                                 shorten=current or not self.bulk_is_linear)
+                self.line_search.attach()
             self._snes = snes
         return self._snes
 

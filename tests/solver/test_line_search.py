@@ -316,3 +316,18 @@ def test_a_trial_point_that_collapses_the_surface_is_a_nan_residual():
     u.x.array[:] = 0.0
     problem.F(u.x.petsc_vec, b)
     assert np.all(np.isfinite(b.array_r)) and problem.evaluation_error is None
+
+
+def test_the_problems_own_snes_takes_the_library_line_search_unless_one_is_chosen():
+    """``problem.solve()`` (the 0.10-style path) halves steps to a non-finite
+    residual and shortens a nonlinear bulk's steps as the load path does."""
+    problem, contact, push = pressed_block("previous")
+    push.value = -0.01
+    assert problem.solve() is problem.u
+    assert problem.solver.getConvergedReason() > 0
+    assert problem.line_search is not None and problem.line_search.shorten
+    assert problem.line_search.full_steps + problem.line_search.cut_steps >= 1
+    chosen = NonlinearContactProblem(neo_hookean_residual(problem.u, 1.0, 0.3), problem.u,
+                                     contact, problem.bcs,
+                                     petsc_options={"snes_linesearch_type": "bt"})
+    assert chosen.solver is not None and chosen.line_search is None
