@@ -179,6 +179,7 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
         f"{kind_name(options.kind)} on the current surface against an elastic master reads "
         f"a false penetration at {count} slave node(s) (largest {worst[0]:.3g} at {where}): "
         "the master covers their elements only in part (cut by the search radius or the "
-        "master's edge), where the dual functions are negative. The boundary modification that cures this in the 'initial' and "
-        "'previous' configurations is not differentiated for 'current'. Use a kind with "
-        "positive functions (kind='LmLS*' or 'LmLS') or basis_configuration='previous'.")
+        "master's edge), where the dual functions are negative. The boundary modification "
+        "that cures this in the 'initial' and 'previous' configurations is not "
+        "differentiated for 'current'. Use a kind with positive functions (kind='LmLS*' or "
+        "'LmLS') or basis_configuration='previous'.")
