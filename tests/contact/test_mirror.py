@@ -74,20 +74,45 @@ def test_dual_kinds_on_the_current_surface_refuse_a_false_penetration(kind):
     assert "LmLS*" in str(err.value) and "previous" in str(err.value)
 
 
-@pytest.mark.parametrize("configuration", ["initial", "previous"])
-@pytest.mark.parametrize("kind", ["LcLS*", "LmLS*"])
+def accepted(configuration: str, kind: str) -> bool:
+    """Whether the library accepts the combination for two curved bodies: on the current
+    surface only the kinds with positive functions (the global kinds couple every slave
+    facet; the dual kinds read a false penetration at u = 0 and, axisymmetric, are not
+    differentiated there)."""
+    return configuration != "current" or kind in ("LmLS", "LmLS*")
+
+
+def mirror_or_refusal(kind: str, configuration: str, n: int, **options):
+    """The mirror result, or None after checking that the library refuses the combination."""
+    if not accepted(configuration, kind):
+        with pytest.raises(NotImplementedError):
+            mirror(n, PRESSED, kind=kind, basis_configuration=configuration, **options)
+        return None
+    return mirror(n, PRESSED, kind=kind, basis_configuration=configuration, **options)
+
+
+SPHERES = [pytest.param(kind, configuration, id=f"{kind}-{configuration}")
+           for kind in KIND_NAMES for configuration in ("initial", "previous", "current")]
+
+
+@pytest.mark.parametrize("kind, configuration", SPHERES)
 def test_two_spheres_in_the_rz_plane_match_the_mirror(kind, configuration):
-    assert_mirror(mirror(20, PRESSED, axisymmetric=True, penalty=2e4, kind=kind,
-                         basis_configuration=configuration))
+    """Nodal active set, n = 20: 2e-5 to 3.1e-4 (the global kinds in "initial")."""
+    result = mirror_or_refusal(kind, configuration, n=20, axisymmetric=True, penalty=2e4)
+    if result is not None:
+        assert_mirror(result)
 
 
-@pytest.mark.parametrize("configuration", ["initial", "previous"])
-@pytest.mark.parametrize("kind", ["LcLS*", "LmLS*"])
+@pytest.mark.parametrize("kind, configuration", SPHERES)
 def test_two_spheres_in_3d_match_the_mirror(kind, configuration):
     """The graded quadrilateral facets are not parallelograms: they are segmented as flat
-    pieces, and the mirror holds to 1.5e-3 (n = 6 to 10), not to the 1e-4 of 2D."""
-    assert_mirror(mirror(6, PRESSED, dim=3, penalty=6e3, kind=kind,
-                         basis_configuration=configuration), scale=3.0)
+    pieces, and at n = 6 the mirror holds to 1.7e-3 in the pressures (LmLS, "current") and
+    6e-4 in the force (GLS, "initial"), not to the 1e-4 of 2D."""
+    result = mirror_or_refusal(kind, configuration, n=6, dim=3, penalty=6e3)
+    if result is None:
+        return
+    assert result.pressure_difference < 3 * PRESSURE_TOLERANCE, result.pressure_difference
+    assert abs(result.force_difference) < 10 * FORCE_TOLERANCE, result.force_difference
 
 
 def test_the_mirror_converges_under_refinement_in_the_initial_configuration(caplog):
