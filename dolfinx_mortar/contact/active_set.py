@@ -15,7 +15,6 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.state import ContactState, GapModel
-from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -35,7 +34,7 @@ def penetrates(model: GapModel, state: ContactState) -> bool:
     slave = model.slave
     comm = slave.layout.comm
     n = slave.layout.num_owned
-    zero = zero_length(length_scale(slave.x, comm))
+    zero = slave.zero_length
     if state.gaps_plus is not None:
         # d̄⁺ integrates ⟨d⟩ with the basis, which may be negative (dual kinds)
         deep = np.abs(state.gaps_plus[:n]) > zero

@@ -24,7 +24,6 @@ from dolfinx_mortar.kinds import (DUAL_KINDS, BasisKind, KindLike, is_global, ki
                                   parse_kind)
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
-from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -163,7 +162,7 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     gaps = current.evaluate(u, None).gaps[:owned]
     reference = modified.evaluate(u, None).gaps[:owned]
     comm = slave.layout.comm
-    tolerance = zero_length(length_scale(slave.x, comm))
+    tolerance = slave.zero_length
     false = (gaps > tolerance) & (reference <= tolerance)
     worst = comm.allreduce((float(gaps[false].max()) if false.any() else 0.0, comm.rank),
                            op=MPI.MAXLOC)

@@ -154,6 +154,9 @@ class ContactTerm(ContactResults):
         self.pattern_changed = False
         self._augmented: Optional[AugmentedNewtonStep] = None
         self._built_at: Optional[FloatArray] = None
+        #: times the default search radius was widened, and whether reaching it was warned
+        self._radius_widenings = 0
+        self._radius_warned = False
         #: global indices of this rank's rows that the last contact Jacobian
         #: stiffened (:meth:`assemble_jacobian`)
         self.stiffened_rows: np.ndarray = np.zeros(0, dtype=PETSc.IntType)
@@ -204,11 +207,11 @@ class ContactTerm(ContactResults):
         step must be solved again, with a new matrix pattern). A radius the user
         gave is kept, with a warning; so is one already widened
         MAX_RADIUS_WIDENINGS times (collective)."""
-        if getattr(self, "_radius_warned", False) or not (
+        if self._radius_warned or not (
                 self.contact_reached_the_search_radius(state)):
             return False
         radius = self.model.coupling.search_radius
-        widenings = getattr(self, "_radius_widenings", 0)
+        widenings = self._radius_widenings
         if self.options.search_radius is None or widenings > 0:
             if widenings < MAX_RADIUS_WIDENINGS:
                 self._radius_widenings = widenings + 1

@@ -12,9 +12,9 @@ where a node at the contact edge changes state, and ``bt`` shrank its steps
 there. :class:`FullStepFirst` keeps ``l2``'s answer for such steps and takes
 the full step, at the cost of one evaluation, when it already lowers ``‖F‖``.
 
-Where the full step only needs to stay finite (the frozen phase of a
-``"current"`` step, and the frozen configurations), it takes full steps and
-halves a step whose residual is NaN or infinite: a finite-strain law with
+Where the full step only needs to stay finite (frozen surfaces under a bulk
+law that is linear in u), it takes full steps and halves a step whose
+residual is NaN or infinite: a finite-strain law with
 ``ln J`` is not defined past J = 0, and ``basic`` ended such steps in
 ``DIVERGED_FUNCTION_NANORINF`` (a neo-Hookean block pressed and slid by a
 rigid disk: 72 steps and 60 cut-backs for the 12 requested).
@@ -158,3 +158,14 @@ class FullStepFirst:
         finally:
             point.destroy()
             residual.destroy()
+
+
+def library_line_search(problem: "NonlinearContactProblem", snes: PETSc.SNES) -> FullStepFirst:
+    """The library's line search for ``problem``, attached to ``snes``: it shortens
+    steps on the current surface and, for a bulk law nonlinear in u, on frozen
+    surfaces too (:meth:`LoadPathSolver.shortens_frozen_steps
+    <dolfinx_mortar.solver.load_path.LoadPathSolver.shortens_frozen_steps>`)."""
+    line_search = FullStepFirst(problem, snes,
+                                shorten=problem.current or not problem.bulk_is_linear)
+    line_search.attach()
+    return line_search

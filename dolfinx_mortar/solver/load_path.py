@@ -28,7 +28,7 @@ from dolfinx_mortar.solver.convergence import (ContactDivergenceError, Equilibri
 from dolfinx_mortar.solver.contact_block_pc import ContactBlockPreconditioner
 from dolfinx_mortar.solver.linear_solver import (DIRECT_OPTIONS, choose_linear_solver,
                                                  iterative_options)
-from dolfinx_mortar.solver.line_search import FullStepFirst
+from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
 from dolfinx_mortar.solver.load_stepping import LoadStepper
 from dolfinx_mortar.solver.newton_start import PathExtrapolation, close_gaps
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
@@ -122,11 +122,8 @@ class LoadPathSolver:
         self.problem.configure_snes(snes)
         snes.setConvergenceHistory()
         self._configure_from_options(snes)
-        shorten = self.current or self.shortens_frozen_steps
-        self.line_search = (FullStepFirst(self.problem, snes, shorten=shorten)
+        self.line_search = (library_line_search(self.problem, snes)
                             if self.library_line_search() else None)
-        if self.line_search is not None:
-            self.line_search.attach()
         return snes
 
     def _configure_from_options(self, snes: PETSc.SNES) -> None:
@@ -169,7 +166,7 @@ class LoadPathSolver:
     @property
     def current(self) -> bool:
         """Whether a contact term uses the current configuration (two phases per step)."""
-        return any(term.basis_configuration == "current" for term in self.contacts)
+        return self.problem.current
 
     def _configure_preconditioner(self, ksp: PETSc.KSP) -> None:
         """The contact-block preconditioner for ``pc_type python`` (the
@@ -334,6 +331,10 @@ class LoadPathSolver:
                 # the extrapolation left the law's domain (J ≤ 0 under ln J) or
                 # collapsed a surface: start from the last converged state
                 x.axpy(-1.0, increment)
+            elif not self.current:
+                # the gap-closing start evaluates the same model at the same x
+                # (with "current" it runs on the frozen surface: another residual)
+                self.problem.offer_residual(x, b)
         for frozen in ([True, False] if self.current else [False]):
             reason = self._solve_phase(snes, x, frozen)
             phases.append([float(r) for r in snes.getConvergenceHistory()[0]])

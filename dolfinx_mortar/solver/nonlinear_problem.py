@@ -32,7 +32,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
-from dolfinx_mortar.solver.line_search import FullStepFirst
+from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 
 
@@ -230,6 +230,11 @@ class NonlinearContactProblem:
                    for term in self.contacts)
 
     @property
+    def current(self) -> bool:
+        """Whether a contact term uses the current configuration (two phases per step)."""
+        return any(term.basis_configuration == "current" for term in self.contacts)
+
+    @property
     def num_dofs(self) -> int:
         V = self.u.function_space
         return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
@@ -267,11 +272,7 @@ class NonlinearContactProblem:
                 snes.setFromOptions()
                 self.configure_ksp(snes.getKSP())
             if not chosen:
-                # the load path's line search, as LoadPathSolver has it
-                current = any(t.basis_configuration == "current" for t in self.contacts)
-                self.line_search = FullStepFirst(self, snes,
-                                                 shorten=current or not self.bulk_is_linear)
-                self.line_search.attach()
+                self.line_search = library_line_search(self, snes)
             self._snes = snes
         return self._snes
 

@@ -6,6 +6,7 @@ the interior), which is the ordering DOLFINx uses for facet closures.
 """
 from __future__ import annotations
 
+from functools import cached_property
 from typing import Optional
 
 import basix
@@ -289,6 +290,13 @@ class LagrangeSurface:
         x = self.x if x is None else x
         return _kernels.element_node_normals(self.facet_type, x,
                                              self.cells.astype(np.int32))
+
+    @cached_property
+    def zero_length(self) -> float:
+        """Lengths at or below this are zero on this surface: the geometric
+        tolerance times its length scale over every rank (collective on first
+        use; the coordinates do not change)."""
+        return zero_length(length_scale(self.x, self.layout.comm))
 
     def moved(self, displacement: FloatArray) -> "LagrangeSurface":
         """The same surface with its nodes displaced (a new configuration)."""

@@ -9,6 +9,7 @@ import pytest
 
 from dolfinx_mortar.contact.active_set import penetrates, stiffened_nodes
 from dolfinx_mortar.layout import NodeLayout
+from dolfinx_mortar.tolerance import length_scale, zero_length
 
 H = 0.1
 
@@ -19,7 +20,8 @@ def point_contact(touching_gap: float):
     the others 0.001, 0.004 and 0.5 away."""
     gaps = np.array([-0.5, -0.004, touching_gap, -0.001, -0.5])
     x = np.column_stack([np.arange(5.0), np.zeros(5)])
-    slave = SimpleNamespace(layout=NodeLayout.serial(5), x=x)
+    slave = SimpleNamespace(layout=NodeLayout.serial(5), x=x,
+                            zero_length=zero_length(length_scale(x)))
     model = SimpleNamespace(slave=slave, covered=np.ones(5, dtype=bool),
                             basis=SimpleNamespace(node_lengths=np.full(5, H)))
     return model, SimpleNamespace(gaps=gaps, gaps_plus=None)
