@@ -101,7 +101,7 @@ def newton_matrix(problem):
     J = problem.problem.matrix()
     problem.problem.F(u, problem.problem.vector())
     problem.problem.J(u, J)
-    cap = problem.contact.augmented_step
+    cap = problem.contact.entry.step
     if cap is not None:
         if cap.G_linearized is not None and cap.G_linearized is not cap.G:
             raise NotImplementedError("condition numbers of the pointwise GLS step")

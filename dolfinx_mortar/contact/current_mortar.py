@@ -26,7 +26,8 @@ from petsc4py import PETSc
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.contact.active_set import NEAR_CONTACT
 from dolfinx_mortar.contact.finite_deformation import CurrentSurfaceGap
-from dolfinx_mortar.kinds import KindLike
+from dolfinx_mortar.contact.penalty_law import PenaltyLaw, safe_weights
+from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
 from dolfinx_mortar.mortar.coupling import (MortarCoupling, gather_surface, polynomial_degree,
                                             segment_quadrature)
@@ -61,7 +62,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
     ----------
     slave, master
         The surfaces in the reference configuration (one displacement space).
-    kind, penalty, scaling, pointwise
+    kind, law
         As for :class:`~dolfinx_mortar.contact.finite_deformation.CurrentSurfaceGap`
         (pointwise: ⟨d⟩ at the segment quadrature points, as with frozen bases).
     search_radius
@@ -72,9 +73,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
 
     moving_pattern = True
 
-    def __init__(self, slave: LagrangeSurface, master: LagrangeSurface, kind: KindLike,
-                 penalty: float, scaling: str = "consistent",
-                 search_radius: Optional[float] = None, pointwise: bool = False):
+    def __init__(self, slave: LagrangeSurface, master: LagrangeSurface, kind: BasisKind,
+                 law: PenaltyLaw, search_radius: Optional[float] = None):
         if slave.gdim == 3 and not (slave.reference.name in SUPPORTED_3D
                                     and master.reference.name in SUPPORTED_3D):
             raise NotImplementedError(
@@ -84,7 +84,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
                 "54-81 variables per pair, which the kernels do not instantiate")
         if master.layout.size_global != slave.layout.size_global:
             raise ValueError("slave and master must share one displacement space (one mesh)")
-        super().__init__(slave, kind, penalty, scaling, pointwise=pointwise)
+        super().__init__(slave, kind, law)
         self.master, self.search_radius = master, search_radius
         degree = polynomial_degree(slave) + max(polynomial_degree(slave),
                                                  polynomial_degree(master))
@@ -215,8 +215,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
         Decided from the same ĝ on every rank. (Until 2026-11 the nodes within
         two element lengths were kept too: 5-10 times the pairs on Hertz 3D,
         for no entry that is used.)"""
-        Wsafe = np.where(W > 0, W, 1.0)
-        y = g * Wsafe ** (-self.k)
+        y = self.law.nodal_gaps(g, safe_weights(W))
         return y >= -2 * NEAR_CONTACT * self.basis.node_lengths
 
     def _variable_dofs(self, nodes: IntArray, num_pairs: int) -> IntArray:

@@ -32,9 +32,10 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.gaps import GapModelBase
+from dolfinx_mortar.contact.penalty_law import PenaltyLaw, safe_weights
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
-from dolfinx_mortar.kinds import DUAL_KINDS, KindLike, is_global, is_partition_of_unity, kind_name
+from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, is_global, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.contact.obstacles import RigidObstacle
@@ -102,30 +103,30 @@ class CurrentSurfaceGap(GapModelBase):
     ----------
     slave
         The slave surface in the reference configuration.
-    kind, penalty, scaling
-        As for :class:`~dolfinx_mortar.contact.gaps.ObstacleGap`; GLS kinds are
-        not supported, dual kinds only on P1 lines and triangles.
+    kind
+        The mortar kind; GLS kinds are not supported, dual kinds only on P1
+        lines and triangles.
+    law
+        The penalty law (:class:`~dolfinx_mortar.contact.penalty_law.PenaltyLaw`).
+        With its pointwise active set (docs/DESIGN.md, §Active sets) the nodal
+        pressures come from ``ĝ⁺_A = ∫ φ_A ⟨d⟩ da`` evaluated at the quadrature
+        points (cells and segments are not split at d = 0). It has no
+        potential; its virtual work is the nodal one with ``⟨y_A⟩`` replaced by
+        ``y⁺_A = ĝ⁺_A W_A^{−k}``, so that it is the nodal model wherever every
+        point of a node's support penetrates, and the Jacobian is its exact
+        (unsymmetric) derivative.
     quadrature_degree
         Degree of the rule for W on every slave facet (default 2p + 2).
-    pointwise
-        The pointwise active set (docs/DESIGN.md, §Active sets): the nodal pressures come from
-        ``ĝ⁺_A = ∫ φ_A ⟨d⟩ da`` evaluated at the quadrature points (cells and
-        segments are not split at d = 0). It has no potential; its virtual
-        work is the nodal one with ``⟨y_A⟩`` replaced by ``y⁺_A = ĝ⁺_A W_A^{−k}``,
-        ``δΠ = Σ_A ε W^{m−k} y⁺ δĝ_A + ε (m/2 − k) W^{m−1} (y⁺)² δW_A``, so that
-        it is the nodal model wherever every point of a node's support
-        penetrates, and the Jacobian is its exact (unsymmetric) derivative.
     """
 
-    def __init__(self, slave: LagrangeSurface, kind: KindLike, penalty: float,
-                 scaling: str = "consistent", quadrature_degree=None,
-                 pointwise: bool = False):
+    def __init__(self, slave: LagrangeSurface, kind: BasisKind, law: PenaltyLaw,
+                 quadrature_degree=None):
         if is_global(kind):
             raise NotImplementedError(
                 f"basis_configuration='current' with {kind_name(kind)}: L(u) couples every "
                 "slave facet and its linearization is not implemented; use a local kind")
-        super().__init__(slave, kind, penalty, scaling)
-        self.pointwise = bool(pointwise)
+        super().__init__(slave, law)
+        self.kind = kind
         ref = slave.reference
         affine = ref.degree == 1 and ref.cell in ("interval", "triangle")
         if self.kind in DUAL_KINDS and not affine:
@@ -150,9 +151,6 @@ class CurrentSurfaceGap(GapModelBase):
         else:
             self.C = np.eye(self.N.shape[1])
         self.phi = self.N @ self.C                                 # φ_A = (N C)_A
-        #: exponents of y = ĝ W^{-k} and ω = ε W^m
-        self.k = 0 if (scaling == "seed" and is_partition_of_unity(self.kind)) else 1
-        self.m = 1 if scaling == "consistent" else 0
         self.covered = slave.layout.on_cells(slave.cells)
         cells, gdim = slave.cells, slave.gdim
         nc, nd = cells.shape
@@ -220,19 +218,6 @@ class CurrentSurfaceGap(GapModelBase):
         dR[..., 0] = 2 * np.pi * self.N
         return R, dR
 
-    def _nodal_coefficients(self, g: FloatArray, W: FloatArray, active: FloatArray):
-        """∂F/∂ĝ, ∂F/∂W and the second derivatives of F = (ε/2) W^m ⟨ĝ W^{−k}⟩²."""
-        eps, k, m = self.penalty, self.k, self.m
-        Wsafe = np.where(W > 0, W, 1.0)
-        y = g * Wsafe ** (-k)
-        yp = np.maximum(y, 0.0)
-        Fg = eps * Wsafe ** (m - k) * yp
-        FW = eps * yp ** 2 * Wsafe ** (m - 1) * (m / 2 - k)
-        Fgg = eps * Wsafe ** (m - 2 * k) * active
-        FgW = eps * Wsafe ** (m - k - 1) * yp * (m - 2 * k)
-        FWW = eps * (m / 2 - k) * yp ** 2 * Wsafe ** (m - 2) * ((m - 1) - 2 * k)
-        return y, Fg, FW, Fgg, FgW, FWW
-
     def _lumped_weights(self, e: dict) -> FloatArray:
         """``W_A = ∫ N_A da`` on the surface of the element quantities ``e``."""
         return self.slave.layout.sum_at_functions(
@@ -242,12 +227,10 @@ class CurrentSurfaceGap(GapModelBase):
         """The contact state at the displacement Function ``u``
         (:class:`CurrentState` in ``data``)."""
         current = self.evaluate_nodes(nodal_displacement(self.slave, u), mask)
-        if self.pointwise:
-            return ContactState(current.y, current.G_y, self.weights * current.y_plus,
-                                current.residual, gaps_plus=current.y_plus,
-                                G_plus=current.G_y_plus, data=current)
-        return ContactState(current.y, current.G_y, self.weights * np.maximum(current.y, 0.0),
-                            current.residual, data=current)
+        return ContactState(current.y, current.G_y,
+                            self.law.force(self.weights, current.y, current.y_plus),
+                            current.residual, gaps_plus=current.y_plus,
+                            G_plus=current.G_y_plus, data=current)
 
     def evaluate_nodes(self, u_nodes: FloatArray, mask: Optional[PETSc.Vec]) -> CurrentState:
         """Nodal gaps, their derivatives and the residual at ``u_nodes`` (local nodes).
@@ -272,14 +255,13 @@ class CurrentSurfaceGap(GapModelBase):
             G_W.diagonalScale(None, mask)
             if G_g_plus is not None:
                 G_g_plus.diagonalScale(None, mask)
-        y, Fg, FW, _, _, _ = self._nodal_coefficients(g, W, np.zeros_like(g))
-        Wsafe = np.where(W > 0, W, 1.0)
+        law, Wsafe = self.law, safe_weights(W)
+        y, Fg, FW, _, _, _ = law.nodal_coefficients(g, Wsafe, np.zeros_like(g))
         y_plus = G_y_plus = None
         if self.pointwise:
             # the nodal virtual work with ⟨y⟩ replaced by y⁺ (see the class)
-            y_plus = gap_data["g_plus"] * Wsafe ** (-self.k)
-            Fg = self.penalty * Wsafe ** (self.m - self.k) * y_plus
-            FW = self.penalty * (self.m / 2 - self.k) * y_plus ** 2 * Wsafe ** (self.m - 1)
+            y_plus = law.nodal_gaps(gap_data["g_plus"], Wsafe)
+            Fg, FW = law.pointwise_coefficients(y_plus, Wsafe)[:2]
             G_y_plus = self._nodal_gap_derivative(G_g_plus, G_W, y_plus, Wsafe)
         residual = G_g.createVecRight()
         tmp = G_W.createVecRight()
@@ -288,22 +270,24 @@ class CurrentSurfaceGap(GapModelBase):
         residual.axpy(1.0, tmp)
         G_y = self._nodal_gap_derivative(G_g, G_W, y, Wsafe)
         #: ω_A for the problem's fallback and gap-closing start
-        self.weights = self.penalty * Wsafe ** self.m
+        self.weights = law.weights(Wsafe)
         self._current_weights = W
-        self.coefficients_std = np.broadcast_to(self.C, (nc, nd, nd)) * (
-            Wsafe[cells] ** (-self.k))[:, None, :]
+        # M̄ = φ W^{-k}: the functions whose integrals are the nodal gaps y
+        self.coefficients_std = law.nodal_gaps(np.broadcast_to(self.C, (nc, nd, nd)),
+                                               Wsafe[cells][:, None, :])
         return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, e, gap_data,
                             y_plus, G_y_plus)
 
     def _nodal_gap_derivative(self, G_g: PETSc.Mat, G_W: PETSc.Mat, y: FloatArray,
                               Wsafe: FloatArray) -> PETSc.Mat:
-        """∂y/∂u of ``y = ĝ W^{−k}``: ``W^{−k} ∂ĝ − k y W^{−1} ∂W`` (also for y⁺ from ĝ⁺)."""
+        """∂y/∂u of ``y = ĝ W^{−k}`` (also for y⁺ from ĝ⁺)."""
         layout = self.slave.layout
+        by_g, by_W = self.law.nodal_gap_factors(y, Wsafe)
         G_y = G_g.copy()
-        G_y.diagonalScale(layout.vector(Wsafe ** (-self.k)), None)
-        if self.k:
+        G_y.diagonalScale(layout.vector(by_g), None)
+        if by_W is not None:
             scaled = G_W.copy()
-            scaled.diagonalScale(layout.vector(-y / Wsafe), None)
+            scaled.diagonalScale(layout.vector(by_W), None)
             G_y.axpy(1.0, scaled, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return G_y
 
@@ -343,18 +327,16 @@ class CurrentSurfaceGap(GapModelBase):
         Different = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
         if pointwise:
             # ∂F_g = a1 ∂y⁺ + b1 ∂W and ∂F_W = a2 ∂y⁺ + b2 ∂W of the pointwise
-            # virtual work's coefficients F_g = ε W^(m−k) y⁺, F_W = ε(m/2−k) W^(m−1) y⁺²
-            eps, k, m = self.penalty, self.k, self.m
-            W = np.where(state.W > 0, state.W, 1.0)
-            yp = state.y_plus
-            left = scaled(state.G_y_plus, eps * W ** (m - k))
-            left.axpy(1.0, scaled(state.G_W, eps * (m - k) * W ** (m - k - 1) * yp),
-                      structure=Different)
-            right = scaled(state.G_y_plus, 2 * eps * (m / 2 - k) * yp * W ** (m - 1))
-            right.axpy(1.0, scaled(state.G_W, eps * (m / 2 - k) * (m - 1) * yp ** 2
-                                   * W ** (m - 2)), structure=Different)
+            # virtual work's coefficients
+            _, _, a1, b1, a2, b2 = self.law.pointwise_coefficients(state.y_plus,
+                                                                   safe_weights(state.W))
+            left = scaled(state.G_y_plus, a1)
+            left.axpy(1.0, scaled(state.G_W, b1), structure=Different)
+            right = scaled(state.G_y_plus, a2)
+            right.axpy(1.0, scaled(state.G_W, b2), structure=Different)
         else:
-            _, _, _, Fgg, FgW, FWW = self._nodal_coefficients(state.g, state.W, active)
+            _, _, _, Fgg, FgW, FWW = self.law.nodal_coefficients(state.g, safe_weights(state.W),
+                                                                 active)
             # outer products: G_gᵀ(Fgg G_g + FgW G_W) + G_Wᵀ(FgW G_g + FWW G_W)
             left = scaled(state.G_g, Fgg)
             left.axpy(1.0, scaled(state.G_W, FgW), structure=Different)
@@ -387,26 +369,15 @@ class CurrentSurfaceGap(GapModelBase):
         """Π_c summed over all ranks (for checking the residual)."""
         e = self._elements(u_nodes)
         g = self._gap(u_nodes, e)[0]
-        W = self._lumped_weights(e)
-        Wsafe = np.where(W > 0, W, 1.0)
-        y = g * Wsafe ** (-self.k)
+        W = safe_weights(self._lumped_weights(e))
         n = self.slave.layout.num_owned
-        local = 0.5 * self.penalty * np.sum((Wsafe ** self.m * np.maximum(y, 0.0) ** 2)[:n])
+        local = np.sum(self.law.energy(g, W)[:n])
         return float(self.slave.layout.comm.allreduce(local))
 
     @property
     def lumped_weights(self) -> FloatArray:
         """W_A on the surface of the last evaluation (the reference one before)."""
         return getattr(self, "_current_weights", self.basis.lumped_weights)
-
-    def pressures_from_gaps(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
-        """``p_A`` in the PU basis on the current surface (see ObstacleGap)."""
-        W = self.lumped_weights
-        force = self.penalty * np.where(W > 0, W, 1.0) ** self.m * (
-            np.maximum(gaps, 0.0) if positive_part else gaps)
-        if self.k == 0:
-            return force
-        return np.divide(force, W, out=np.zeros_like(W), where=W > 0)
 
 
 class CurrentObstacleGap(CurrentSurfaceGap):
@@ -417,12 +388,11 @@ class CurrentObstacleGap(CurrentSurfaceGap):
     :class:`CurrentSurfaceGap`, plus the ``obstacle``.
     """
 
-    def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: KindLike,
-                 penalty: float, scaling: str = "consistent", quadrature_degree=None,
-                 pointwise: bool = False):
+    def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: BasisKind,
+                 law: PenaltyLaw, quadrature_degree=None):
         if obstacle.gdim != slave.gdim:
             raise ValueError(f"a {obstacle.gdim}D obstacle cannot touch a {slave.gdim}D body")
-        super().__init__(slave, kind, penalty, scaling, quadrature_degree, pointwise)
+        super().__init__(slave, kind, law, quadrature_degree)
         self.obstacle = obstacle
 
     def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:

@@ -32,8 +32,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.contact.state import ContactState
-from dolfinx_mortar.kinds import (BasisKind, KindLike, is_global, is_partition_of_unity,
-                                  parse_kind, unstarred_partner)
+from dolfinx_mortar.contact.penalty_law import PenaltyLaw
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling
@@ -43,22 +42,6 @@ from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.contact.sparse_products import TransposeProduct, transpose_mat_mult
 
 FloatArray = npt.NDArray[np.float64]
-
-SCALINGS = ("consistent", "seed")
-
-
-def gap_kind(kind: KindLike, scaling: str) -> BasisKind:
-    """The basis whose integrals define the nodal gaps for a scaling.
-
-    For GLS/GLS* this is the standard basis N: their gaps are ``L⁻¹ ∫N d``
-    (:class:`GlobalGap`).
-    """
-    if scaling not in SCALINGS:
-        raise ValueError(f"unknown scaling '{scaling}'; expected one of {SCALINGS}")
-    kind = parse_kind(kind)
-    if is_global(kind):
-        return BasisKind.LmLS_star
-    return unstarred_partner(kind) if scaling == "consistent" else kind
 
 
 def dof_layout(nodes: NodeLayout, bs: int) -> NodeLayout:
@@ -72,25 +55,18 @@ class GapModelBase:
     and what the models with frozen bases share of
     :class:`~dolfinx_mortar.contact.state.GapModel`."""
 
-    augmented = False
     moving_pattern = False
-    #: the pointwise active set (d̄⁺ = ∫M̄⟨d⟩) instead of the nodal one
-    pointwise = False
     #: the segmentation against an elastic master (None against an obstacle)
     coupling = None
 
-    def __init__(self, slave: LagrangeSurface, kind: KindLike, penalty: float,
-                 scaling: str):
-        if not np.isfinite(penalty) or penalty <= 0:
-            raise ValueError(f"the penalty must be positive and finite, got {penalty}")
+    def __init__(self, slave: LagrangeSurface, law: PenaltyLaw):
         self.slave = slave
-        self.kind = parse_kind(kind)
-        self.scaling = scaling
-        self.penalty = float(penalty)
-        self.basis = MortarBasis(gap_kind(kind, scaling), slave)
-        W = self.basis.lumped_weights
+        self.law = law
+        #: the pointwise active set (d̄⁺ = ∫M̄⟨d⟩) instead of the nodal one
+        self.pointwise = law.pointwise
+        self.basis = MortarBasis(law.gap_kind, slave)
         #: ω_A of Π_c = Σ (ω_A/2)⟨d̄_A⟩²
-        self.weights = self.penalty * (W if scaling == "consistent" else np.ones_like(W))
+        self.weights = law.weights(self.basis.lumped_weights)
         self.dofs = dof_layout(slave.layout, slave.gdim)
         T = slave.reference.transform
         C = self.basis.coefficients
@@ -106,31 +82,15 @@ class GapModelBase:
 
     def nodal_pressures(self, state: ContactState) -> FloatArray:
         """``p_A = ε⟨d̄_A⟩`` (nodal active set) or ``ε d̄⁺_A`` (pointwise),
-        consistent scaling (:meth:`pressures_from_gaps`)."""
-        if state.gaps_plus is not None:
-            return self.pressures_from_gaps(state.gaps_plus, positive_part=False)
-        return self.pressures_from_gaps(state.gaps)
+        consistent scaling (:meth:`PenaltyLaw.pressure
+        <dolfinx_mortar.contact.penalty_law.PenaltyLaw.pressure>`)."""
+        return self.law.pressure(self.weights, self.lumped_weights, state.gaps,
+                                 state.gaps_plus)
 
     def mortar_traction(self, state: ContactState) -> FloatArray:
         """``p* = Σ_A f_A M_A`` at the nodes of every slave cell, (cells, nodes)."""
         # M_A at node b of cell c is C[c, b, A]: N_std is 1 at its own node
         return np.einsum("cba,ca->cb", self.coefficients_std, state.force[self.slave.cells])
-
-    def pressures_from_gaps(self, gaps: FloatArray, positive_part: bool = True) -> FloatArray:
-        """Pressure coefficients ``p_A`` of the contact traction in a PU basis.
-
-        The traction is ``Σ_A ω_A ⟨d_A⟩ M_A`` with ``M`` the gap basis. A non-PU
-        ``M_A`` is ``M*_A / W_A``, so ``p_A = ω_A ⟨d_A⟩ / W_A`` (in the
-        consistent scaling ``ε⟨d̄_A⟩``); a PU gap basis (seed scaling with a
-        starred kind) gives ``p_A = ω_A ⟨d_A⟩`` directly. ``positive_part=False``
-        takes ``gaps`` as they are (the pointwise active set's ``d̄⁺``, which is
-        already an integral of ⟨d⟩ and may be negative for dual kinds).
-        """
-        force = self.weights * (np.maximum(gaps, 0.0) if positive_part else gaps)
-        if is_partition_of_unity(self.basis.kind):
-            return force
-        W = self.lumped_weights
-        return np.divide(force, W, out=np.zeros_like(W), where=W > 0)
 
     def state(self, gaps: FloatArray, G: PETSc.Mat, force: FloatArray,
               mask: Optional[PETSc.Vec], gaps_plus: Optional[FloatArray] = None,
@@ -196,12 +156,10 @@ class ObstacleGap(GapModelBase):
     Exact in u (no segmentation: the obstacle lies below every slave point).
     """
 
-    def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: KindLike,
-                 penalty: float, scaling: str = "consistent",
+    def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, law: PenaltyLaw,
                  quadrature_degree: Optional[int] = None,
-                 reference: Optional[FloatArray] = None, pointwise: bool = False):
-        super().__init__(slave, kind, penalty, scaling)
-        self.pointwise = pointwise
+                 reference: Optional[FloatArray] = None):
+        super().__init__(slave, law)
         #: nodal displacement that moved ``slave`` to its configuration (or None)
         self.reference = reference
         if obstacle.gdim != slave.gdim:
@@ -218,7 +176,7 @@ class ObstacleGap(GapModelBase):
     def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
         """The contact state at the displacement Function ``u``."""
         gaps, G, x, gaps_plus, G_plus = self.raw_gaps(u)
-        force = self.weights * (gaps_plus if self.pointwise else np.maximum(gaps, 0.0))
+        force = self.law.force(self.weights, gaps, gaps_plus)
         return self.state(gaps, G, force, mask, gaps_plus, G_plus, self.curvature(force, x))
 
     def raw_gaps(self, u):
@@ -289,12 +247,13 @@ class MortarGap(GapModelBase):
     ``d̄_A(u) = d̄_A⁰ + n_A·(Σ_B D̄_AB Δu_B − Σ_C M̄_AC Δu_C)``, ``Δu = u − reference``.
     """
 
-    def __init__(self, coupling: MortarCoupling, kind: KindLike, penalty: float,
-                 scaling: str = "consistent", reference: Optional[PETSc.Vec] = None,
-                 boundary_modification: bool = False):
+    def __init__(self, coupling: MortarCoupling, law: PenaltyLaw,
+                 reference: Optional[PETSc.Vec] = None, boundary_modification: bool = False):
         self.reference = reference
-        self.pointwise = coupling.points is not None
-        super().__init__(coupling.slave, kind, penalty, scaling)
+        super().__init__(coupling.slave, law)
+        if self.pointwise and coupling.points is None:
+            raise ValueError("the pointwise active set needs MortarCoupling(..., "
+                             "keep_points=True)")
         if coupling.master.layout is not coupling.slave.layout and (
                 coupling.master.layout.size_global != coupling.slave.layout.size_global):
             raise ValueError("MortarGap needs slave and master in one mesh (one displacement "
@@ -309,8 +268,7 @@ class MortarGap(GapModelBase):
             self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
             _, _, W_cov = coupling.covered_element_mass()
             self._weights_source = W_cov
-            if scaling == "consistent":
-                self.weights = self.penalty * W_cov
+            self.weights = law.weights(W_cov)
         C = self.coefficients_std[coupling.pairs[:, 0]]
         Dn, Mn, gn = coupling.raw_pairs
         Dg = np.einsum("pba,pbc->pac", C, Dn)        # ∫ M̄_A N_B
@@ -341,8 +299,8 @@ class MortarGap(GapModelBase):
     def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
         """The contact state at the displacement Function ``u``."""
         gaps, G, _, gaps_plus, G_plus = self.raw_gaps(u)
-        force = self.weights * (gaps_plus if self.pointwise else np.maximum(gaps, 0.0))
-        return self.state(gaps, G, force, mask, gaps_plus, G_plus)
+        return self.state(gaps, G, self.law.force(self.weights, gaps, gaps_plus), mask,
+                          gaps_plus, G_plus)
 
     def raw_gaps(self, u):
         """Nodal gaps, G (a copy), None (no curvature), and (pointwise) d̄⁺, G⁺."""

@@ -15,8 +15,9 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.contact.gaps import GapModelBase
+from dolfinx_mortar.contact.penalty_law import PenaltyLaw
 from dolfinx_mortar.contact.state import ContactState
-from dolfinx_mortar.kinds import BasisKind, KindLike, parse_kind
+from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import MassMatrixSolver
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 
@@ -46,14 +47,12 @@ class GlobalGap:
     cylinders at zero load).
     """
 
-    augmented = True
     moving_pattern = False
 
-    def __init__(self, inner: GapModelBase, kind: KindLike, penalty: float, scaling: str,
+    def __init__(self, inner: GapModelBase, law: PenaltyLaw,
                  mass: Optional[tuple[MassMatrixSolver, FloatArray]] = None):
         self.inner = inner
-        self.kind = parse_kind(kind)
-        self.scaling = scaling
+        self.law = law
         self.slave = inner.slave
         self.pointwise = inner.pointwise
         self.coupling = inner.coupling
@@ -62,39 +61,22 @@ class GlobalGap:
                                                       self.basis.lumped_weights)
         #: W_A = ∫ N_A over the part that enters the projection
         self.lumped_weights = W
-        # Π_c = Σ (ω_A/2)⟨d̄_A⟩² in terms of the GLS gap d̄ (∫M_A = 1):
-        # consistent ω = εW; seed GLS ω = ε; seed GLS* (d_A = W_A d̄_A) ω = εW².
-        if scaling == "consistent":
-            weights = penalty * W
-        elif self.kind == BasisKind.GLS:
-            weights = penalty * np.ones_like(W)
-        else:
-            weights = penalty * W ** 2
         self.dofs = inner.dofs
         self.covered = inner.covered
         #: owned local nodes of the slave surface (the rows the Newton step needs)
         owned = np.unique(self.slave.cells)
         self.surface_rows = owned[owned < self.slave.layout.num_owned]
-        self.weights = np.where(self.covered, weights, 0.0)
+        # Π_c = Σ (ω_A/2)⟨d̄_A⟩² in terms of the GLS gap d̄ (∫M_A = 1)
+        self.weights = np.where(self.covered, law.weights(W), 0.0)
 
     def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
         """``d̄ = L⁻¹ĝ``, Ĝ, and ``z = L⁻¹ω⟨d̄⟩`` (pointwise: ``L⁻¹ω d̄⁺``)."""
         g, G, x, g_plus, G_plus = self.inner.raw_gaps(u)
         gaps = self.mass.solve(g)
-        gaps_plus = None
-        if self.pointwise:
-            gaps_plus = self.mass.solve(g_plus)
-            force = self.mass.solve(self.weights * gaps_plus)
-        else:
-            force = self.mass.solve(self.weights * np.maximum(gaps, 0.0))
+        gaps_plus = self.mass.solve(g_plus) if self.pointwise else None
+        force = self.mass.solve(self.law.force(self.weights, gaps, gaps_plus))
         K_curv = self.inner.curvature(force, x) if x is not None else None
         return self.inner.state(gaps, G, force, mask, gaps_plus, G_plus, K_curv)
-
-    def jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
-                 geometric: bool = True) -> PETSc.Mat:
-        raise NotImplementedError(
-            "GLS kinds have a dense Newton matrix; the contact term applies the exact step "
-            "through the augmented system (ContactTerm.configure_ksp)")
 
     def nodal_force(self, values: FloatArray) -> FloatArray:
         """``z = L⁻¹ values``: the nodal force of ``R_c = Ĝᵀ z``."""
@@ -103,9 +85,7 @@ class GlobalGap:
     def nodal_pressures(self, state: ContactState) -> FloatArray:
         """``p_A = ω_A⟨d̄_A⟩/W_A`` (pointwise: ``ω_A d̄⁺_A/W_A``), the
         coefficients of the traction in the PU basis GLS*."""
-        W = self.lumped_weights
-        gaps = state.gaps_plus if state.gaps_plus is not None else np.maximum(state.gaps, 0.0)
-        return np.divide(self.weights * gaps, W, out=np.zeros_like(W), where=W > 0)
+        return self.law.pressure(self.weights, self.lumped_weights, state.gaps, state.gaps_plus)
 
     def mortar_traction(self, state: ContactState) -> FloatArray:
         """``p* = Σ_A f_A (N L⁻¹)_A = Σ_B N_B z_B`` at the nodes of every slave cell."""

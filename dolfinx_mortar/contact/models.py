@@ -6,8 +6,7 @@ through :class:`~dolfinx_mortar.contact.state.GapModel` alone.
 """
 from __future__ import annotations
 
-import warnings
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Optional
 
 import numpy as np
@@ -16,86 +15,25 @@ from mpi4py import MPI
 
 from dolfinx_mortar.contact.current_mortar import CurrentMortarGap
 from dolfinx_mortar.contact.finite_deformation import CurrentObstacleGap
-from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap, gap_kind
+from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
 from dolfinx_mortar.contact.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle
+from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.state import GapModel
-from dolfinx_mortar.kinds import (DUAL_KINDS, BasisKind, KindLike, is_global, kind_name,
-                                  parse_kind)
+from dolfinx_mortar.kinds import DUAL_KINDS, is_global, kind_name
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
 FloatArray = npt.NDArray[np.float64]
-
-ACTIVE_SETS = ("nodal", "pointwise")
-CONFIGURATIONS = ("initial", "previous", "current")
-
-
-@dataclass(frozen=True)
-class ContactOptions:
-    """The options of a contact term (see :class:`~dolfinx_mortar.contact.term.ContactTerm`),
-    checked on construction."""
-
-    kind: BasisKind
-    penalty: float
-    scaling: str = "consistent"
-    active_set: str = "nodal"
-    basis_configuration: str = "initial"
-    boundary_modification: bool = False
-    search_radius: Optional[float] = None
-    axisymmetric: bool = False
-
-    @classmethod
-    def checked(cls, kind: KindLike, penalty: float, scaling: str, active_set: str,
-                basis_configuration: str, boundary_modification: Optional[bool],
-                search_radius: Optional[float], elastic_master: bool,
-                axisymmetric: bool = False) -> "ContactOptions":
-        gap_kind(kind, scaling)  # names an unknown kind or scaling
-        kind = parse_kind(kind)
-        if not (isinstance(penalty, (int, float, np.floating, np.integer))
-                and np.isfinite(penalty) and penalty > 0):
-            raise ValueError(f"the penalty must be positive and finite, got {penalty!r}")
-        if active_set not in ACTIVE_SETS:
-            raise ValueError(f"unknown active set '{active_set}'; expected {ACTIVE_SETS}")
-        if basis_configuration not in CONFIGURATIONS:
-            raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
-                             f"expected {CONFIGURATIONS}")
-        if boundary_modification is None:
-            # the dual functions are negative near a facet's far node: a facet the
-            # master covers only there reads a separation as a penetration. The
-            # modification is the cure wherever it is implemented.
-            boundary_modification = (elastic_master and kind in DUAL_KINDS
-                                     and basis_configuration != "current"
-                                     and active_set == "nodal")
-        if basis_configuration == "current" and boundary_modification:
-            raise NotImplementedError("basis_configuration='current' with the boundary "
-                                      "modification is not implemented")
-        if boundary_modification and not (elastic_master and kind in DUAL_KINDS):
-            raise ValueError("the consistent boundary modification applies to the dual kinds "
-                             "(LcLS*, LcLS) with an elastic master (master_tag)")
-        if search_radius is not None and not (np.isfinite(search_radius) and search_radius > 0):
-            raise ValueError(f"the search radius must be positive and finite, got "
-                             f"{search_radius!r}")
-        if active_set == "pointwise" and kind in DUAL_KINDS:
-            warnings.warn("the pointwise active set with a dual kind: ∫M̄_A⟨d⟩ is negative "
-                          "next to the contact edge, and Newton did not converge on any "
-                          "curved contact tested (Hertz 2D); prefer active_set='nodal'",
-                          RuntimeWarning, stacklevel=4)
-        return cls(kind, float(penalty), scaling, active_set, basis_configuration,
-                   bool(boundary_modification),
-                   None if search_radius is None else float(search_radius), bool(axisymmetric))
 
 
 def current_model(options: ContactOptions, slave: LagrangeSurface,
                   master: Optional[LagrangeSurface],
                   obstacle: Optional[RigidObstacle]) -> GapModel:
     """The model with the bases on the current surface, exact Jacobian."""
-    pointwise = options.active_set == "pointwise"
     if obstacle is not None:
-        return CurrentObstacleGap(slave, obstacle, options.kind, options.penalty,
-                                  options.scaling, pointwise=pointwise)
-    return CurrentMortarGap(slave, master, options.kind, options.penalty, options.scaling,
-                            options.search_radius, pointwise=pointwise)
+        return CurrentObstacleGap(slave, obstacle, options.kind, options.law)
+    return CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius)
 
 
 def frozen_model(options: ContactOptions, slave: LagrangeSurface,
@@ -105,24 +43,22 @@ def frozen_model(options: ContactOptions, slave: LagrangeSurface,
     ``u_nodes`` (None: the initial one), linear in u about it (exact in u
     against an obstacle). ``u_vector``: the displacement vector of ``u_nodes``
     (an elastic master's model is linear about it)."""
-    pointwise = options.active_set == "pointwise"
+    law = options.law
     if obstacle is not None:
         moved = slave if u_nodes is None else slave.moved(u_nodes)
-        model = ObstacleGap(moved, obstacle, options.kind, options.penalty, options.scaling,
-                            reference=u_nodes, pointwise=pointwise)
+        model = ObstacleGap(moved, obstacle, law, reference=u_nodes)
         mass = None
     else:
         if u_nodes is not None:  # bases and segmentation in the configuration u
             slave, master = slave.moved(u_nodes), master.moved(u_nodes)
-        coupling = MortarCoupling(slave, master, keep_points=pointwise,
+        coupling = MortarCoupling(slave, master, keep_points=law.pointwise,
                                   search_radius=options.search_radius,
                                   interface_normals=True)
-        model = MortarGap(coupling, options.kind, options.penalty, options.scaling,
-                          None if u_nodes is None else u_vector,
+        model = MortarGap(coupling, law, None if u_nodes is None else u_vector,
                           boundary_modification=options.boundary_modification)
         mass = covered_mass(coupling) if is_global(options.kind) else None
     if is_global(options.kind):
-        return GlobalGap(model, options.kind, options.penalty, options.scaling, mass)
+        return GlobalGap(model, law, mass)
     return model
 
 
@@ -153,8 +89,7 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     wider block) passes. Returns the frozen model's coupling where it was made
     (None elsewhere), for the term's other checks.
     """
-    if not (options.basis_configuration == "current" and master is not None
-            and options.kind in DUAL_KINDS and options.active_set == "nodal"):
+    if not (master is not None and options.kind in DUAL_KINDS and not options.law.pointwise):
         return None
     frozen = replace(options, basis_configuration="previous", boundary_modification=True)
     modified = frozen_model(frozen, slave, master, None, u_nodes, u.x.petsc_vec.copy())

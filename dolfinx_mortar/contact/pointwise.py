@@ -23,6 +23,7 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.cut_quadrature import positive_part_rule
+from dolfinx_mortar.contact.penalty_law import positive_part
 from dolfinx_mortar.surfaces.lagrange import measure_from_tangents
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 
@@ -93,7 +94,7 @@ def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: Fl
     x = np.einsum("nb,nbk->nk", N, x_nodes[cells[c]])
     dq = -model.obstacle.signed_distance(x)
     # the rule covers {d > 0} up to the bisection tolerance: clip the rest
-    dq = np.maximum(dq, 0.0)
+    dq = positive_part(dq)
     Mbar = np.einsum("nb,nba->na", N, model.coefficients_std[c])
     values.append(Mbar * (w * dq)[:, None])
     rows.append(cells[c])
@@ -161,7 +162,7 @@ class MortarPointGaps:
         d = self.point_gaps(u)
         active = d > 0
         layout = self.model.slave.layout
-        gaps = layout.sum_at_functions(self.rows, self.wM * np.maximum(d, 0.0)[:, None])
+        gaps = layout.sum_at_functions(self.rows, self.wM * positive_part(d)[:, None])
         a = np.flatnonzero(active)
         blocks = np.einsum("qa,qw->qaw", self.wM[a], self.dd[a])
         return gaps, _assemble_gap_derivative(self.model, self.rows[a], self.cols[a], blocks)

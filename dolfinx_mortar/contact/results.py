@@ -279,7 +279,7 @@ class ContactResults:
         normal force growing 3× and a frictionless tangential force of 33% of
         it without a word. Against a rigid obstacle the gap is exact in u
         whatever the slip (no segmentation is frozen): no warning."""
-        if (self.basis_configuration != "initial" or self.obstacle is not None
+        if (not self.configuration.pairs_found_once or self.obstacle is not None
                 or getattr(self, "_slip_warned", False)):
             return
         s = self.slip(state)
@@ -325,7 +325,7 @@ class ContactResults:
                           stacklevel=3)
             return
         never = (" With basis_configuration='initial' the pairs are found only here, so "
-                 "it never will." if self.basis_configuration == "initial" else "")
+                 "it never will." if self.configuration.pairs_found_once else "")
         warnings.warn(f"no slave facet finds a master facet within the search radius "
                       f"{radius:.3g} along its normal: the contact cannot act until the "
                       f"surfaces come within it.{never} Check the slave and master tags and "
@@ -344,7 +344,7 @@ class ContactResults:
         graded to h = a/40 lost the outer fifth of the contact zone that way and
         had the pressure 51% off.
         """
-        if self.master is None or self.basis_configuration == "current":
+        if self.master is None or self.configuration.follows_u:
             return False
         model, slave = self.model, self.slave
         comm = self.mesh.comm

@@ -53,8 +53,6 @@ class GapModel(Protocol):
     covered: npt.NDArray[np.bool_]
     #: ω_A of the penalty potential Π_c = Σ (ω_A/2)⟨d̄_A⟩²
     weights: FloatArray
-    #: the Newton matrix is dense (GLS kinds): the step comes from an augmented system
-    augmented: bool
     #: the pairs, and so the matrix pattern, change inside a Newton solve
     moving_pattern: bool
 

@@ -28,29 +28,25 @@ import numpy as np
 import numpy.typing as npt
 from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
-from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.active_set import gap_closing_force, stiffened_nodes
-from dolfinx_mortar.contact.augmented import AugmentedNewtonStep
-from dolfinx_mortar.contact.models import (ContactOptions, current_model, frozen_model, moved,
-                                           refuse_false_penetration)
+from dolfinx_mortar.contact.configuration import configuration_of
+from dolfinx_mortar.contact.newton_entry import entry_of
 from dolfinx_mortar.contact.obstacles import RigidObstacle
+from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.results import ContactResults
-from dolfinx_mortar.contact.sparse_products import PatternTrackingAdd
 from dolfinx_mortar.contact.state import ContactState, GapModel
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.input_checks import check_cells, check_contact_tags
-from dolfinx_mortar.surfaces.facet_surface import facet_surface, nodal_displacement
+from dolfinx_mortar.surfaces.facet_surface import facet_surface
 
 FloatArray = npt.NDArray[np.float64]
 logger = logging.getLogger(__name__)
 #: how many times a default search radius is widened (×4 each) before the
 #: contact zone's reaching it is only warned about
 MAX_RADIUS_WIDENINGS = 3
-SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
-DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 
 
 class ContactTerm(ContactResults):
@@ -129,10 +125,9 @@ class ContactTerm(ContactResults):
         if obstacle is not None and obstacle.gdim != gdim:
             raise ValueError(f"a {obstacle.gdim}D obstacle in a {gdim}D mesh: the option "
                              "does not fit the mesh's dimension")
-        self.options = ContactOptions.checked(kind, penalty, scaling, active_set,
-                                              basis_configuration, boundary_modification,
-                                              search_radius, master_tag is not None,
-                                              axisymmetric)
+        options = ContactOptions.checked(kind, penalty, scaling, active_set,
+                                         basis_configuration, boundary_modification,
+                                         search_radius, master_tag is not None, axisymmetric)
         if axisymmetric and gdim != 2:
             raise ValueError(f"axisymmetric contact needs a 2D (r, z) mesh, got a {gdim}D one")
         check_cells(mesh)
@@ -142,45 +137,41 @@ class ContactTerm(ContactResults):
         self.slave = facet_surface(V, facet_tags, slave_tag, quadratic_transform, axisymmetric)
         self.master = (facet_surface(V, facet_tags, master_tag, axisymmetric=axisymmetric)
                        if master_tag is not None else None)
+        #: the checked options (kind, penalty law, configuration, …)
+        self.options = options
+        #: where the bases live and when they move
+        self.configuration = configuration_of(options, self.slave, self.master, obstacle)
+        #: how the contact stiffness enters Newton's linear solve
+        self.entry = entry_of(options.kind, mesh.comm, V.dofmap.index_map_bs)
         #: wall times of the contact work by part, seconds (accumulated)
         self.timings: dict[str, float] = {}
         self.state: Optional[ContactState] = None
         self._masks: dict = {}
-        self._last_active: Optional[FloatArray] = None
-        #: adds K to the Newton matrix when its pattern may change ("current")
-        self._add_stiffness = PatternTrackingAdd()
         #: whether the last :meth:`assemble_jacobian` changed the matrix's
         #: nonzero pattern in a way PETSc does not see (the KSP must be reset)
         self.pattern_changed = False
-        self._augmented: Optional[AugmentedNewtonStep] = None
-        self._built_at: Optional[FloatArray] = None
         #: times the default search radius was widened, and whether reaching it was warned
         self._radius_widenings = 0
         self._radius_warned = False
-        #: global indices of this rank's rows that the last contact Jacobian
-        #: stiffened (:meth:`assemble_jacobian`)
-        self.stiffened_rows: np.ndarray = np.zeros(0, dtype=PETSc.IntType)
-        self.model: GapModel = self._build(None)
-        frozen = refuse_false_penetration(self.options, self.slave, self.master, self.model,
-                                          u, nodal_displacement(self.slave, u))
+        self.model: GapModel = self._timed_build(self.configuration.build, options)
         self.warn_deep_initial_penetration()
-        self.warn_if_no_master_is_in_reach(frozen)
+        self.warn_if_no_master_is_in_reach(self.configuration.segmentation(self.model))
 
     # -- configuration ---------------------------------------------------------------
     @property
     def basis_configuration(self) -> str:
-        return self.options.basis_configuration
+        """``"initial"``, ``"previous"`` or ``"current"``."""
+        return self.configuration.name
 
-    def _build(self, u_nodes: Optional[FloatArray]) -> GapModel:
+    def _timed_build(self, build, options: ContactOptions) -> Optional[GapModel]:
+        """``build(options, u)``; where it makes a new model (not None), the
+        state of the old one is dropped."""
         clock = time.perf_counter()
-        if self.basis_configuration == "current":
-            model = current_model(self.options, self.slave, self.master, self.obstacle)
-        else:
-            model = frozen_model(self.options, self.slave, self.master, self.obstacle,
-                                 u_nodes, None if u_nodes is None else self.u.x.petsc_vec.copy())
-            self._built_at = None if u_nodes is None else u_nodes.copy()
-        self._last_active, self.state = None, None
-        self.timings["setup"] = time.perf_counter() - clock
+        model = build(options, self.u)
+        if model is not None:
+            self.state = None
+            self.configuration.forget()
+            self.timings["setup"] = time.perf_counter() - clock
         return model
 
     def begin_step(self) -> bool:
@@ -191,12 +182,10 @@ class ContactTerm(ContactResults):
         since they were built; returns True then (the contact pattern may have
         changed: :meth:`create_matrix` again).
         """
-        if self.basis_configuration != "previous":
+        model = self._timed_build(self.configuration.begin_step, self.options)
+        if model is None:
             return False
-        u_nodes = nodal_displacement(self.slave, self.u)
-        if not moved(u_nodes, self._built_at, self.mesh.comm):
-            return False
-        self.model = self._build(u_nodes)
+        self.model = model
         return True
 
     def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:
@@ -216,7 +205,7 @@ class ContactTerm(ContactResults):
             if widenings < MAX_RADIUS_WIDENINGS:
                 self._radius_widenings = widenings + 1
                 self.options = replace(self.options, search_radius=4 * radius)
-                self.model = self._build(self._built_at)
+                self.model = self._timed_build(self.configuration.rebuild, self.options)
                 if self.mesh.comm.rank == 0:
                     logger.info("the contact zone reached slave nodes with no master within "
                                 "the search radius %.3g: bases rebuilt with %.3g, step "
@@ -235,16 +224,16 @@ class ContactTerm(ContactResults):
         """With ``basis_configuration="current"``: the model frozen at the present u
         (the "previous" model) inside the block. A load-path driver solves each
         step with it first; other configurations are unchanged."""
-        if self.basis_configuration != "current":
+        frozen = self.configuration.frozen_model(self.options, self.u)
+        if frozen is None:
             yield
             return
-        current = self.model
-        self.model = frozen_model(self.options, self.slave, self.master, self.obstacle,
-                                  nodal_displacement(self.slave, self.u), self.u.x.petsc_vec.copy())
+        current, self.model = self.model, frozen
         try:
             yield
         finally:
-            self.model, self.state, self._last_active = current, None, None
+            self.model, self.state = current, None
+            self.configuration.forget()
 
     @property
     def moving_pattern(self) -> bool:
@@ -252,9 +241,10 @@ class ContactTerm(ContactResults):
         return self.model.moving_pattern
 
     @property
-    def augmented(self) -> bool:
-        """Whether the Newton step needs :meth:`configure_ksp` (GLS kinds)."""
-        return self.model.augmented
+    def symmetric(self) -> bool:
+        """Whether the contact Jacobian is symmetric: the nodal active set on
+        frozen bases."""
+        return not (self.options.law.pointwise or self.configuration.follows_u)
 
     # -- PETSc assembly --------------------------------------------------------------
     def mask(self, bcs: Sequence[fem.DirichletBC] = ()) -> PETSc.Vec:
@@ -301,54 +291,22 @@ class ContactTerm(ContactResults):
         if self.state is None:
             self.update(bcs)
         clock = time.perf_counter()
-        mask = self.mask(bcs)
         state = self.state
-        self.pattern_changed = False
-        if self.model.augmented:
-            if self._augmented is None:
-                self._augmented = AugmentedNewtonStep(self.mesh.comm, self.augmented_prefix)
-            self._augmented.update_from(A, state, self.model, self.active_nodes_mask(state))
-        else:
-            settled = True
-            active = self.active_nodes_mask(state)
-            if self.basis_configuration == "current":
-                # Far from the solution the pressure on the current surface can
-                # be many times its final value, and so its geometric stiffness:
-                # full Newton steps then cycled between active sets (Hertz 2D).
-                # While the active set moves the frozen-surface part alone gives
-                # the step; once it settles the exact Jacobian converges
-                # quadratically.
-                settled = self.mesh.comm.allreduce(bool(
-                    self._last_active is not None
-                    and np.array_equal(active, self._last_active)), op=MPI.LAND)
-                self._last_active = active
-            K = self.model.jacobian(state, active, mask, geometric=settled)
-            self.stiffened_rows = stiffened_rows(K, self.V.dofmap.index_map_bs)
-            if self.basis_configuration == "current":
-                self.pattern_changed = self._add_stiffness(A, K)
-            else:
-                A.axpy(1.0, K, structure=SUBSET)
-            A.assemble()
+        self.pattern_changed = self.entry.assemble(A, self.model, state,
+                                                   self.active_nodes_mask(state),
+                                                   self.mask(bcs), self.configuration)
         self._add("jacobian", clock)
 
     @property
-    def augmented_step(self) -> Optional[AugmentedNewtonStep]:
-        """GLS kinds: the exact Newton step of the last :meth:`assemble_jacobian`."""
-        return self._augmented
-
-    #: options prefix of the augmented system's KSP (GLS kinds)
-    augmented_prefix = "dolfinx_mortar_augmented_"
+    def stiffened_rows(self) -> np.ndarray:
+        """Global indices of this rank's rows that the last contact Jacobian
+        stiffened (:meth:`assemble_jacobian`; none for GLS kinds)."""
+        return self.entry.stiffened_rows
 
     def configure_ksp(self, ksp: PETSc.KSP) -> None:
         """Make ``ksp`` apply the exact Newton step (GLS kinds: the augmented
         system, a python PC; other kinds: nothing to do)."""
-        if not self.model.augmented:
-            return
-        if self._augmented is None:
-            self._augmented = AugmentedNewtonStep(self.mesh.comm, self.augmented_prefix)
-        ksp.setType("preonly")
-        ksp.getPC().setType("python")
-        ksp.getPC().setPythonContext(self._augmented)
+        self.entry.configure_ksp(ksp)
 
     def create_matrix(self, a: fem.Form, bcs: Sequence = ()) -> PETSc.Mat:
         """A matrix whose pattern holds the bilinear form ``a`` and the contact
@@ -356,12 +314,9 @@ class ContactTerm(ContactResults):
         A = fem_petsc.create_matrix(a)
         fem_petsc.assemble_matrix(A, a, list(bcs))
         A.assemble()
-        if self.model.augmented:
-            return A
-        state = self.state or self.update(bcs)
-        A.axpy(1.0, self.model.pattern(state), structure=DIFFERENT)
-        self._add_stiffness.reset()
-        if self.moving_pattern or self.basis_configuration == "previous":
+        self.entry.add_pattern(A, self.model, self.state or self.update(bcs))
+        self.configuration.new_matrix()
+        if self.moving_pattern or self.configuration.pattern_grows:
             # the pairs, and so the pattern, change with u: new entries are
             # allocated as they come
             A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
@@ -379,24 +334,3 @@ class ContactTerm(ContactResults):
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
-
-
-#: rows whose diagonal is below this fraction of the largest contact diagonal
-#: count as unstiffened: a preconditioning choice (such a row is left to
-#: multigrid), not a correctness decision
-STIFFENED_FRACTION = 1e-12
-
-
-def stiffened_rows(K: PETSc.Mat, bs: int) -> np.ndarray:
-    """Global indices of the owned rows of a contact Jacobian ``K`` with a
-    diagonal entry above :data:`STIFFENED_FRACTION` of K's largest (over all
-    ranks); whole dof blocks of size ``bs`` (nodes), so that a node's
-    directions stay together."""
-    diagonal = K.getDiagonal()
-    scale = diagonal.norm(PETSc.NormType.NORM_INFINITY)
-    values = np.abs(diagonal.array_r).reshape(-1, bs).max(axis=1)
-    start = diagonal.getOwnershipRange()[0]
-    diagonal.destroy()
-    nodes = np.flatnonzero(values > STIFFENED_FRACTION * scale)
-    return (start + bs * nodes[:, None] + np.arange(bs)).ravel().astype(PETSc.IntType)
-

@@ -65,7 +65,7 @@ class LoadPathSolver:
                  linear_solver: str = "auto"):
         self.problem = problem
         self.prefix = prefix
-        augmented = any(term.augmented for term in problem.contacts)
+        augmented = any(term.entry.takes_the_linear_solve for term in problem.contacts)
         gdim = problem.u.function_space.mesh.geometry.dim
         #: "direct" or "iterative", as chosen for this problem
         self.linear_solver = choose_linear_solver(linear_solver, problem.num_dofs, gdim,

@@ -78,8 +78,8 @@ class NonlinearContactProblem:
         for term in self.contacts:
             if term.u is not u:
                 raise ValueError("every contact term must be built on the problem's u")
-        if sum(term.augmented for term in self.contacts) > 1 or (
-                len(self.contacts) > 1 and any(term.augmented for term in self.contacts)):
+        if len(self.contacts) > 1 and any(term.entry.takes_the_linear_solve
+                                          for term in self.contacts):
             raise NotImplementedError("a GLS kind (augmented Newton step) must be the only "
                                       "contact term of a problem")
         fc = form_compiler_options or {}
@@ -225,14 +225,12 @@ class NonlinearContactProblem:
     def symmetric(self) -> bool:
         """Whether the Newton matrix is symmetric: the nodal active set on the
         initial or previous configuration, for every contact term."""
-        return all(term.options.active_set == "nodal"
-                   and term.basis_configuration in ("initial", "previous")
-                   for term in self.contacts)
+        return all(term.symmetric for term in self.contacts)
 
     @property
     def current(self) -> bool:
         """Whether a contact term uses the current configuration (two phases per step)."""
-        return any(term.basis_configuration == "current" for term in self.contacts)
+        return any(term.configuration.follows_u for term in self.contacts)
 
     @property
     def num_dofs(self) -> int:

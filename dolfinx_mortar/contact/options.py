@@ -1,0 +1,85 @@
+"""The options of a contact term, checked once where the term is made."""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from dolfinx_mortar.contact.penalty_law import PenaltyLaw
+from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, parse_kind
+
+CONFIGURATIONS = ("initial", "previous", "current")
+
+
+@dataclass(frozen=True)
+class ContactOptions:
+    """The options of a contact term (see :class:`~dolfinx_mortar.contact.term.ContactTerm`),
+    checked on construction (:meth:`checked`).
+
+    Attributes
+    ----------
+    kind
+        The mortar basis kind.
+    law
+        The penalty law: penalty, scaling and active set
+        (:class:`~dolfinx_mortar.contact.penalty_law.PenaltyLaw`).
+    basis_configuration
+        ``"initial"``, ``"previous"`` or ``"current"``
+        (:mod:`~dolfinx_mortar.contact.configuration`).
+    boundary_modification
+        The dual basis rebuilt over the covered part of partly covered facets.
+    search_radius
+        How far along its normal a slave facet reaches for master facets (None:
+        the default of the configuration).
+    axisymmetric
+        The mesh is the (r, z) meridian of a body of revolution.
+    """
+
+    kind: BasisKind
+    law: PenaltyLaw
+    basis_configuration: str = "initial"
+    boundary_modification: bool = False
+    search_radius: Optional[float] = None
+    axisymmetric: bool = False
+
+    @property
+    def penalty(self) -> float:
+        """ε, pressure per length."""
+        return self.law.penalty
+
+    @classmethod
+    def checked(cls, kind: KindLike, penalty: float, scaling: str, active_set: str,
+                basis_configuration: str, boundary_modification: Optional[bool],
+                search_radius: Optional[float], elastic_master: bool,
+                axisymmetric: bool = False) -> "ContactOptions":
+        """The options from a term's arguments; names the first that is wrong."""
+        law = PenaltyLaw.of(kind, penalty, scaling, active_set)
+        kind = parse_kind(kind)
+        if basis_configuration not in CONFIGURATIONS:
+            raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
+                             f"expected {CONFIGURATIONS}")
+        if boundary_modification is None:
+            # the dual functions are negative near a facet's far node: a facet the
+            # master covers only there reads a separation as a penetration. The
+            # modification is the cure wherever it is implemented.
+            boundary_modification = (elastic_master and kind in DUAL_KINDS
+                                     and basis_configuration != "current"
+                                     and not law.pointwise)
+        if basis_configuration == "current" and boundary_modification:
+            raise NotImplementedError("basis_configuration='current' with the boundary "
+                                      "modification is not implemented")
+        if boundary_modification and not (elastic_master and kind in DUAL_KINDS):
+            raise ValueError("the consistent boundary modification applies to the dual kinds "
+                             "(LcLS*, LcLS) with an elastic master (master_tag)")
+        if search_radius is not None and not (np.isfinite(search_radius) and search_radius > 0):
+            raise ValueError(f"the search radius must be positive and finite, got "
+                             f"{search_radius!r}")
+        if law.pointwise and kind in DUAL_KINDS:
+            warnings.warn("the pointwise active set with a dual kind: ∫M̄_A⟨d⟩ is negative "
+                          "next to the contact edge, and Newton did not converge on any "
+                          "curved contact tested (Hertz 2D); prefer active_set='nodal'",
+                          RuntimeWarning, stacklevel=4)
+        return cls(kind, law, basis_configuration, bool(boundary_modification),
+                   None if search_radius is None else float(search_radius), bool(axisymmetric))
