@@ -157,9 +157,9 @@ def slave_coordinates(problem) -> np.ndarray:
 def contact_force(problem) -> float:
     """Σ_A ω_A⟨d̄_A⟩ over the owned slave nodes (the total normal contact force)."""
     n = problem.slave.layout.num_owned
-    g = problem.nodal_gaps()
+    state = problem.contact.evaluate()
     return problem.mesh.comm.allreduce(
-        float(np.sum(problem.gap_model.weights[:n] * np.maximum(g[:n], 0.0))))
+        float(np.sum(state.weights[:n] * np.maximum(state.gaps[:n], 0.0))))
 
 
 # -- 1. contact boundary sweeping across a slave element edge -----------------------

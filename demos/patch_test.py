@@ -112,7 +112,8 @@ def run(args, orientation: str, kind: str, scaling: str, comm=MPI.COMM_WORLD) ->
                              tractions={TOP: traction},
                              quadratic_transform=(args.degree == 2 and d == 3))
     result = problem.solve(load_steps=1)
-    p = problem.nodal_pressures()
+    state = problem.contact.evaluate()
+    p = problem.contact.nodal_pressures(state)
     n = problem.slave.layout.num_owned
     on = np.zeros(problem.slave.layout.size_local, dtype=bool)
     on[problem.slave.cells] = True
@@ -120,7 +121,7 @@ def run(args, orientation: str, kind: str, scaling: str, comm=MPI.COMM_WORLD) ->
     # the uniform pressure that carries the applied force over the slave surface
     # the bases live on (the unit face, or in the current configuration the
     # face stretched sideways by the Poisson effect)
-    area = comm.allreduce(float(np.sum(problem.gap_model.lumped_weights[:n])))
+    area = comm.allreduce(float(np.sum(state.lumped_weights[:n])))
     deviation = float(np.max(np.abs(values * area / args.pressure - 1.0)))
     return {"dim": d, "degree": args.degree, "orientation": orientation, "kind": kind,
             "scaling": scaling, "max_relative_deviation": deviation,

@@ -14,6 +14,7 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.contact.penalty_law import PenaltyLaw
 from dolfinx_mortar.contact.state import ContactState, GapModel
 
 FloatArray = npt.NDArray[np.float64]
@@ -39,7 +40,7 @@ def penetrates(model: GapModel, state: ContactState) -> bool:
         # d̄⁺ integrates ⟨d⟩ with the basis, which may be negative (dual kinds)
         deep = np.abs(state.gaps_plus[:n]) > zero
     else:
-        deep = model.covered[:n] & (state.gaps[:n] > zero)
+        deep = state.covered[:n] & (state.gaps[:n] > zero)
     return bool(comm.allreduce(bool(np.any(deep)), op=MPI.LOR))
 
 
@@ -54,8 +55,8 @@ def stiffened_nodes(model: GapModel, state: ContactState) -> FloatArray:
     is active the Jacobian is exact again. Nodes with nothing below them have
     no gap and are never active.
     """
-    covered = model.covered
-    active = covered & (state.gaps >= 0)
+    covered = state.covered
+    active = covered & PenaltyLaw.active(state.gaps)
     if not penetrates(model, state):
         active = covered & (state.gaps >= -NEAR_CONTACT * model.basis.node_lengths)
     return active.astype(np.float64)
@@ -80,7 +81,7 @@ def gap_closing_force(model: GapModel, state: ContactState) -> Optional[PETSc.Ve
     near = stiffened_nodes(model, state)
     if comm.allreduce(int(np.sum(near[:n]))) == 0:
         return None
-    force = model.nodal_force(model.weights * near * state.gaps)
+    force = model.nodal_force(state.weights * near * state.gaps)
     pull = state.G.createVecRight()
     state.G.multTranspose(slave.layout.vector(force), pull)
     return pull

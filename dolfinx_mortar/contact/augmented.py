@@ -47,9 +47,9 @@ class AugmentedNewtonStep:
         K = A.copy()
         if state.K_curv is not None:
             K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        G_right, weights = state.G, model.weights * active
+        G_right, weights = state.G, state.weights * active
         if state.gaps_plus is not None and model.inner.any_penetration(state.gaps_plus):
-            G_right, weights = state.G_plus, model.weights
+            G_right, weights = state.G_plus, state.weights
         self.update(K, state.G, weights, model.mass.matrix, G_right, model.surface_rows)
 
     def update(self, K: PETSc.Mat, G: PETSc.Mat, weights: FloatArray, L: PETSc.Mat,

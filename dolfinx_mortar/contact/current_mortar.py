@@ -97,9 +97,6 @@ class CurrentMortarGap(CurrentSurfaceGap):
         self._gathered_slave_ids = np.concatenate(
             comm.allgather(slave.layout.global_indices[slave.cells])).reshape(
                 -1, slave.cells.shape[1])
-        self.covered = np.zeros(slave.layout.size_local, dtype=bool)
-        #: the kernel's coupling at the last evaluation (pairs, reference values)
-        self.coupling: Optional[MortarCoupling] = None
 
     def pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
                          which: Optional[npt.NDArray[np.bool_]] = None,
@@ -142,7 +139,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
             node_weights=node_weights)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
-    def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
+    def _gap(self, u_nodes: FloatArray, e: dict
+             ) -> tuple[FloatArray, PETSc.Mat, dict, npt.NDArray[np.bool_]]:
         slave, layout = self.slave, self.slave.layout
         # the pairs are found again at every evaluation, and only those near
         # contact matter: each facet searches two of its own diameters
@@ -153,7 +151,6 @@ class CurrentMortarGap(CurrentSurfaceGap):
                                                        if self.search_radius is None
                                                        else None),
                                   keep_points=self.pointwise)
-        self.coupling = coupling
         all_cells = slave.cells[coupling.pairs[:, 0]]
         # the values of every pair from the double kernel; derivatives only
         # where a node may carry contact force or stiffness
@@ -169,7 +166,6 @@ class CurrentMortarGap(CurrentSurfaceGap):
             near |= layout.on_cells(all_cells[penetrating])
         kept = np.any(near[all_cells], axis=1)
         cells = all_cells[kept]
-        self.covered = layout.on_cells(all_cells)
         ns = cells.shape[1]
         data = {"cells": cells, "pairs": np.flatnonzero(kept), "u_nodes": u_nodes,
                 "coupling": coupling, "kept": kept}
@@ -203,7 +199,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
             G_g = assemble_global_blocks(layout, self._gathered_slave_ids[pairs[:, 0]], dofs,
                                          grad, cols=self.dofs)
         data["dofs"] = dofs
-        return g, G_g, data
+        return g, G_g, data, layout.on_cells(all_cells)
 
     def near_contact(self, g: FloatArray, W: FloatArray) -> npt.NDArray[np.bool_]:
         """Nodes whose gap derivatives are needed: those that may get contact

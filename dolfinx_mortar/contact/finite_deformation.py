@@ -87,6 +87,9 @@ class CurrentState:
     FW: FloatArray           #: ∂F/∂W_A at the local nodes
     element: dict            #: area-element arrays the second derivatives of W need
     gap_data: object         #: what the gap's source needs for Σ_A F_g,A ∂²ĝ_A
+    weights: FloatArray      #: ω = ε W^m on the current surface
+    covered: npt.NDArray[np.bool_]  #: slave nodes with something to touch at this u
+    coefficients: FloatArray  #: M̄ = φ W^{−k} on every slave cell (the traction's)
     #: pointwise active set: y⁺ = ĝ⁺ W^{−k} with ĝ⁺_A = ∫ φ_A ⟨d⟩ da, and ∂y⁺/∂u
     y_plus: Optional[FloatArray] = None
     G_y_plus: Optional[PETSc.Mat] = None
@@ -159,11 +162,12 @@ class CurrentSurfaceGap(GapModelBase):
         self.cell_dofs = self.node_dofs(cells).reshape(nc, nd * gdim)
 
     # -- what a gap source provides ------------------------------------------------------
-    def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, object]:
+    def _gap(self, u_nodes: FloatArray, e: dict
+             ) -> tuple[FloatArray, PETSc.Mat, object, npt.NDArray[np.bool_]]:
         """``ĝ_A`` at the local nodes (summed over ranks), ``∂ĝ/∂u`` (slave rows ×
-        dofs, Dirichlet columns not yet dropped) and data for :meth:`_gap_hessian`;
-        with :attr:`pointwise` the data also hold ``"g_plus"`` (ĝ⁺, summed over
-        ranks) and ``"G_g_plus"`` (∂ĝ⁺/∂u)."""
+        dofs, Dirichlet columns not yet dropped), data for :meth:`_gap_hessian`
+        (with :attr:`pointwise` also ``"g_plus"``, ĝ⁺ summed over ranks, and
+        ``"G_g_plus"``, ∂ĝ⁺/∂u) and the slave nodes with something to touch at u."""
         raise NotImplementedError
 
     def _gap_hessian(self, data: object, Fg: Optional[FloatArray]) -> PETSc.Mat:
@@ -228,9 +232,11 @@ class CurrentSurfaceGap(GapModelBase):
         (:class:`CurrentState` in ``data``)."""
         current = self.evaluate_nodes(nodal_displacement(self.slave, u), mask)
         return ContactState(current.y, current.G_y,
-                            self.law.force(self.weights, current.y, current.y_plus),
+                            self.law.force(current.weights, current.y, current.y_plus),
                             current.residual, gaps_plus=current.y_plus,
-                            G_plus=current.G_y_plus, data=current)
+                            G_plus=current.G_y_plus, data=current, weights=current.weights,
+                            lumped_weights=current.W, covered=current.covered,
+                            coefficients=current.coefficients)
 
     def evaluate_nodes(self, u_nodes: FloatArray, mask: Optional[PETSc.Vec]) -> CurrentState:
         """Nodal gaps, their derivatives and the residual at ``u_nodes`` (local nodes).
@@ -244,7 +250,7 @@ class CurrentSurfaceGap(GapModelBase):
         cells, layout = self.slave.cells, self.slave.layout
         nc, nd = cells.shape
         gdim = self.slave.gdim
-        g, G_g, gap_data = self._gap(u_nodes, e)
+        g, G_g, gap_data, covered = self._gap(u_nodes, e)
         W = self._lumped_weights(e)
         dW_c = np.einsum("q,qa,cqbi->cabi", self.wq, self.N, e["dJ"])
         G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
@@ -269,14 +275,11 @@ class CurrentSurfaceGap(GapModelBase):
         G_W.multTranspose(layout.vector(FW), tmp)
         residual.axpy(1.0, tmp)
         G_y = self._nodal_gap_derivative(G_g, G_W, y, Wsafe)
-        #: ω_A for the problem's fallback and gap-closing start
-        self.weights = law.weights(Wsafe)
-        self._current_weights = W
         # M̄ = φ W^{-k}: the functions whose integrals are the nodal gaps y
-        self.coefficients_std = law.nodal_gaps(np.broadcast_to(self.C, (nc, nd, nd)),
-                                               Wsafe[cells][:, None, :])
+        coefficients = law.nodal_gaps(np.broadcast_to(self.C, (nc, nd, nd)),
+                                      Wsafe[cells][:, None, :])
         return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, e, gap_data,
-                            y_plus, G_y_plus)
+                            law.weights(Wsafe), covered, coefficients, y_plus, G_y_plus)
 
     def _nodal_gap_derivative(self, G_g: PETSc.Mat, G_W: PETSc.Mat, y: FloatArray,
                               Wsafe: FloatArray) -> PETSc.Mat:
@@ -305,7 +308,7 @@ class CurrentSurfaceGap(GapModelBase):
                   geometric: bool, structure_only: bool) -> PETSc.Mat:
         """:meth:`jacobian`; ``structure_only``: every entry it may have, with
         the gap's second derivatives as structural zeros (not computed)."""
-        state = state.data
+        weights, state = state.weights, state.data
         layout = self.slave.layout
         # pointwise: while nothing penetrates, G⁺ = 0 and the nodal form
         # (non-geometric) stiffens the touching nodes instead, as when frozen
@@ -315,7 +318,7 @@ class CurrentSurfaceGap(GapModelBase):
             geometric = False
         if not geometric:
             right = (state.G_y_plus if pointwise else state.G_y).copy()
-            right.diagonalScale(layout.vector(self.weights * (1.0 if pointwise else active)),
+            right.diagonalScale(layout.vector(weights * (1.0 if pointwise else active)),
                                 None)
             return transpose_mat_mult(state.G_y, right)
 
@@ -374,10 +377,6 @@ class CurrentSurfaceGap(GapModelBase):
         local = np.sum(self.law.energy(g, W)[:n])
         return float(self.slave.layout.comm.allreduce(local))
 
-    @property
-    def lumped_weights(self) -> FloatArray:
-        """W_A on the surface of the last evaluation (the reference one before)."""
-        return getattr(self, "_current_weights", self.basis.lumped_weights)
 
 
 class CurrentObstacleGap(CurrentSurfaceGap):
@@ -395,7 +394,8 @@ class CurrentObstacleGap(CurrentSurfaceGap):
         super().__init__(slave, kind, law, quadrature_degree)
         self.obstacle = obstacle
 
-    def _gap(self, u_nodes: FloatArray, e: dict) -> tuple[FloatArray, PETSc.Mat, dict]:
+    def _gap(self, u_nodes: FloatArray, e: dict
+             ) -> tuple[FloatArray, PETSc.Mat, dict, npt.NDArray[np.bool_]]:
         cells, layout = self.slave.cells, self.slave.layout
         nc, nd = cells.shape
         gdim = self.slave.gdim
@@ -423,7 +423,7 @@ class CurrentObstacleGap(CurrentSurfaceGap):
                                  e["J"] * penetrating, v))
             data["G_g_plus"] = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
                                                dgp_c.reshape(nc, nd, nd * gdim))
-        return g, G_g, data
+        return g, G_g, data, self.covered
 
     def _gap_hessian(self, data: dict, Fg: Optional[FloatArray]) -> PETSc.Mat:
         e, d, v = data["e"], data["d"], data["v"]

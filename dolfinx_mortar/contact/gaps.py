@@ -84,13 +84,13 @@ class GapModelBase:
         """``p_A = ε⟨d̄_A⟩`` (nodal active set) or ``ε d̄⁺_A`` (pointwise),
         consistent scaling (:meth:`PenaltyLaw.pressure
         <dolfinx_mortar.contact.penalty_law.PenaltyLaw.pressure>`)."""
-        return self.law.pressure(self.weights, self.lumped_weights, state.gaps,
+        return self.law.pressure(state.weights, state.lumped_weights, state.gaps,
                                  state.gaps_plus)
 
     def mortar_traction(self, state: ContactState) -> FloatArray:
         """``p* = Σ_A f_A M_A`` at the nodes of every slave cell, (cells, nodes)."""
         # M_A at node b of cell c is C[c, b, A]: N_std is 1 at its own node
-        return np.einsum("cba,ca->cb", self.coefficients_std, state.force[self.slave.cells])
+        return np.einsum("cba,ca->cb", state.coefficients, state.force[self.slave.cells])
 
     def state(self, gaps: FloatArray, G: PETSc.Mat, force: FloatArray,
               mask: Optional[PETSc.Vec], gaps_plus: Optional[FloatArray] = None,
@@ -106,7 +106,9 @@ class GapModelBase:
                 K_curv.diagonalScale(mask, mask)
         residual = G.createVecRight()
         G.multTranspose(self.slave.layout.vector(force), residual)
-        return ContactState(gaps, G, force, residual, K_curv, gaps_plus, G_plus)
+        return ContactState(gaps, G, force, residual, K_curv, gaps_plus, G_plus,
+                            weights=self.weights, lumped_weights=self.lumped_weights,
+                            covered=self.covered, coefficients=self.coefficients_std)
 
     def jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
                  geometric: bool = True) -> PETSc.Mat:
@@ -115,9 +117,9 @@ class GapModelBase:
         With the pointwise set and no penetration anywhere G⁺ = 0: the nodal
         form with ``active`` stiffens the touching nodes instead.
         """
-        G_right, weights = state.G, self.weights * active
+        G_right, weights = state.G, state.weights * active
         if state.gaps_plus is not None and self.any_penetration(state.gaps_plus):
-            G_right, weights = state.G_plus, self.weights
+            G_right, weights = state.G_plus, state.weights
         SG = G_right.copy()
         SG.diagonalScale(self.slave.layout.vector(weights), None)
         K = self._stiffness_product(state.G, SG)

@@ -7,6 +7,7 @@ are assembled, and the Newton step solves the augmented system
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Optional
 
 import numpy as np
@@ -76,7 +77,8 @@ class GlobalGap:
         gaps_plus = self.mass.solve(g_plus) if self.pointwise else None
         force = self.mass.solve(self.law.force(self.weights, gaps, gaps_plus))
         K_curv = self.inner.curvature(force, x) if x is not None else None
-        return self.inner.state(gaps, G, force, mask, gaps_plus, G_plus, K_curv)
+        return replace(self.inner.state(gaps, G, force, mask, gaps_plus, G_plus, K_curv),
+                       weights=self.weights, lumped_weights=self.lumped_weights)
 
     def nodal_force(self, values: FloatArray) -> FloatArray:
         """``z = L⁻¹ values``: the nodal force of ``R_c = Ĝᵀ z``."""
@@ -85,7 +87,8 @@ class GlobalGap:
     def nodal_pressures(self, state: ContactState) -> FloatArray:
         """``p_A = ω_A⟨d̄_A⟩/W_A`` (pointwise: ``ω_A d̄⁺_A/W_A``), the
         coefficients of the traction in the PU basis GLS*."""
-        return self.law.pressure(self.weights, self.lumped_weights, state.gaps, state.gaps_plus)
+        return self.law.pressure(state.weights, state.lumped_weights, state.gaps,
+                                 state.gaps_plus)
 
     def mortar_traction(self, state: ContactState) -> FloatArray:
         """``p* = Σ_A f_A (N L⁻¹)_A = Σ_B N_B z_B`` at the nodes of every slave cell."""

@@ -123,9 +123,9 @@ class ContactResults:
     def normal_force(self, state: Optional[ContactState] = None) -> float:
         """``∫ p dA = Σ_A W_A p_A`` over all ranks (a scalar)."""
         n = self.slave.layout.num_owned
+        state = state or self.evaluate()
         p = self.nodal_pressures(state)
-        W = self.model.lumped_weights
-        return float(self.mesh.comm.allreduce(float(np.sum((W * p)[:n]))))
+        return float(self.mesh.comm.allreduce(float(np.sum((state.lumped_weights * p)[:n]))))
 
     def contact_force(self, state: Optional[ContactState] = None) -> FloatArray:
         """The resultant of the contact traction on the slave body, a gdim-vector:
@@ -158,13 +158,13 @@ class ContactResults:
         """Warn when the configuration penetrates by more than DEEP_PENETRATION
         slave element lengths (a rigid plane placed 0.2 deep into a 0.5-high
         block solved without a word)."""
-        gaps = self.nodal_gaps()
+        state = self.evaluate()
         slave = self.slave
         # nodes of this rank's cells (on_cells also counts other ranks' cells)
         on_local_cell = np.zeros(slave.layout.size_local, dtype=bool)
         on_local_cell[slave.cells] = True
-        covered = self.model.covered & on_local_cell
-        ratio, gap, x = self._deepest(np.where(covered, gaps, -np.inf))
+        covered = state.covered & on_local_cell
+        ratio, gap, x = self._deepest(np.where(covered, state.gaps, -np.inf))
         if ratio > DEEP_PENETRATION:
             hint = ""
             options = self.options
@@ -301,13 +301,12 @@ class ContactResults:
         never paired, since only opposing facets are; a master beyond the
         search radius is not paired either, and in the initial configuration
         it never will be. ``coupling``: a segmentation of this configuration
-        already made (the model's is used where it has one).
+        already made (None: one is made here).
         """
         if self.master is None:
             return
         comm = self.mesh.comm
         radius = self.options.search_radius
-        coupling = getattr(self.model, "coupling", coupling)
         if coupling is None:        # the current surface: one segmentation for this check
             coupling = MortarCoupling(self.slave, self.master, search_radius=radius)
         if comm.allreduce(len(coupling.pairs)) > 0:
@@ -348,7 +347,8 @@ class ContactResults:
             return False
         model, slave = self.model, self.slave
         comm = self.mesh.comm
-        covered = model.covered
+        state = state or self.evaluate()
+        covered = state.covered
         cells = slave.cells
         # p is ε⟨d̄⟩: exactly 0 off the active set
         active = self.nodal_pressures(state) > 0

@@ -31,6 +31,13 @@ class ContactState:
     d̄⁺ and its derivative (None with the nodal set); ``K_curv`` the obstacle's
     curvature stiffness (None if flat); ``data`` what a model's Jacobian
     needs beyond that (the current configuration's).
+
+    What the surface was at this displacement is part of the state, not of
+    the model: ``weights`` (ω of the law), ``lumped_weights`` (W),
+    ``covered`` (the slave nodes with something to touch) and
+    ``coefficients`` (M̄ on every slave cell in the displacement's basis, for
+    the traction) are the model's constants with frozen bases and follow u on
+    the current surface.
     """
 
     gaps: FloatArray
@@ -41,6 +48,10 @@ class ContactState:
     gaps_plus: Optional[FloatArray] = None
     G_plus: Optional[PETSc.Mat] = None
     data: Any = None
+    weights: Optional[FloatArray] = None
+    lumped_weights: Optional[FloatArray] = None
+    covered: Optional[npt.NDArray[np.bool_]] = None
+    coefficients: Optional[FloatArray] = None
 
 
 class GapModel(Protocol):
@@ -49,15 +60,8 @@ class GapModel(Protocol):
     :mod:`~dolfinx_mortar.contact.finite_deformation`,
     :mod:`~dolfinx_mortar.contact.current_mortar`)."""
 
-    #: slave nodes that have something (master or obstacle) to touch
-    covered: npt.NDArray[np.bool_]
-    #: ω_A of the penalty potential Π_c = Σ (ω_A/2)⟨d̄_A⟩²
-    weights: FloatArray
     #: the pairs, and so the matrix pattern, change inside a Newton solve
     moving_pattern: bool
-
-    @property
-    def lumped_weights(self) -> FloatArray: ...
 
     def evaluate(self, u: Any, mask: Optional[PETSc.Vec]) -> ContactState:
         """The state at the displacement Function ``u``; ``mask`` is 1 on free

@@ -33,7 +33,7 @@ from dolfinx_mortar.solver.load_stepping import LoadStepper
 from dolfinx_mortar.solver.newton_start import PathExtrapolation, close_gaps
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
-from dolfinx_mortar.solver.step_results import SolveResult, StepResult
+from dolfinx_mortar.solver.step_results import NewtonOutcome, SolveResult, StepResult
 
 logger = logging.getLogger(__name__)
 _SNES = PETSc.SNES.ConvergedReason
@@ -242,11 +242,10 @@ class LoadPathSolver:
                     clock = time.perf_counter()
                     x = u.x.petsc_vec.copy()
                     increment = path.increment(target) if path is not None else None
-                    reason, phases, iterations, cause, reference, linear = self.newton_step(
-                        snes, x, increment)
-                    history = [r for phase in phases for r in phase]
-                    if reason <= 0:
-                        attempt = FailedAttempt(target, reason, history, cause)
+                    outcome = self.newton_step(snes, x, increment)
+                    if not outcome.converged:
+                        attempt = FailedAttempt(target, outcome.reason, outcome.residuals,
+                                                outcome.cause)
                         failures.append(attempt)
                         stepper.failed()
                         if stepper.exhausted:
@@ -255,7 +254,8 @@ class LoadPathSolver:
                         if self.comm.rank == 0:
                             logger.warning("load step to t = %.6g failed after %d Newton "
                                            "iterations (%s); cut back to t = %.6g",
-                                           target, iterations, cause, stepper.target())
+                                           target, outcome.iterations, outcome.cause,
+                                           stepper.target())
                         saved.copy(u.x.petsc_vec)
                         u.x.scatter_forward()
                         continue
@@ -276,9 +276,9 @@ class LoadPathSolver:
                     deepest = [max(worst, term.penetration(state), key=lambda d: d[0])
                                for worst, term, state in zip(deepest, self.contacts, states)]
                     active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
-                    step = StepResult(target, iterations, history,
-                                      time.perf_counter() - clock, active, phases, reference,
-                                      linear)
+                    step = StepResult(target, outcome.iterations, outcome.residuals,
+                                      time.perf_counter() - clock, active, outcome.phases,
+                                      outcome.reference, outcome.linear_iterations)
                     result.steps.append(step)
                     before = stepper.fraction_of_steps
                     stepper.succeeded()
@@ -299,12 +299,8 @@ class LoadPathSolver:
         return result
 
     def newton_step(self, snes: PETSc.SNES, x: PETSc.Vec,
-                    increment: Optional[PETSc.Vec] = None
-                    ) -> tuple[int, list, int, str, float, int]:
-        """One load step's Newton solve from x (plus a predictor's ``increment``):
-        SNES reason, the residual norms of each SNES solve, iterations, what
-        stopped it if it failed (in words), the force scale F and the Krylov
-        iterations.
+                    increment: Optional[PETSc.Vec] = None) -> NewtonOutcome:
+        """One load step's Newton solve from x (plus a predictor's ``increment``).
 
         The step is accepted when ``‖R‖ ≤ rtol·F``
         (:class:`~dolfinx_mortar.solver.convergence.EquilibriumTest`) with F the
@@ -345,8 +341,8 @@ class LoadPathSolver:
                 if self.equilibrium.cause is not None or reason == _SNES.DIVERGED_MAX_IT:
                     # Newton ran and got nowhere (not a failed linear solve or residual)
                     cause += self._contact_hint()
-                return reason, phases, iterations, cause, reference, linear
-        return reason, phases, iterations, "", reference, linear
+                return NewtonOutcome(reason, phases, iterations, cause, reference, linear)
+        return NewtonOutcome(reason, phases, iterations, "", reference, linear)
 
     def _contact_hint(self) -> str:
         """What the contact says about a failed Newton solve, from its state at

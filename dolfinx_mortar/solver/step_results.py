@@ -5,6 +5,34 @@ from dataclasses import dataclass, field
 
 
 @dataclass
+class NewtonOutcome:
+    """How one load step's Newton solve ended
+    (:meth:`~dolfinx_mortar.solver.load_path.LoadPathSolver.newton_step`)."""
+
+    #: the SNES converged reason of the last solve (> 0: converged)
+    reason: int
+    #: residual norms per SNES solve (two with ``"current"``: frozen, then current surface)
+    phases: list
+    #: Newton iterations over all phases
+    iterations: int
+    #: what stopped it, in words ("" when it converged)
+    cause: str
+    #: the step's force scale F (the out-of-balance force where it started)
+    reference: float
+    #: Krylov iterations of its linear solves
+    linear_iterations: int
+
+    @property
+    def converged(self) -> bool:
+        return self.reason > 0
+
+    @property
+    def residuals(self) -> list:
+        """Residual norms of every Newton iterate, the phases one after another."""
+        return [r for phase in self.phases for r in phase]
+
+
+@dataclass
 class StepResult:
     """One converged load step."""
 

@@ -194,8 +194,7 @@ def test_current_configuration_measure_is_the_swept_area():
                              basis_configuration="current", axisymmetric=True)
     problem.u.interpolate(lambda x: np.vstack([0.01 * x[0], 0.0 * x[1]]))
     problem.u.x.scatter_forward()
-    problem.contact.evaluate()
-    W = problem.gap_model.lumped_weights
+    W = problem.contact.evaluate().lumped_weights
     n = problem.slave.layout.num_owned
     total = problem.mesh.comm.allreduce(float(np.sum(W[:n])))
     assert abs(total - np.pi * 1.01 ** 2) <= 1e-12 * np.pi

@@ -27,8 +27,8 @@ def test_differentiable_gaps_equal_the_kernels(kind, degree):
     state = problem.contact.evaluate()
     model = problem.gap_model
     data = state.data.gap_data
-    kernel = (model.coupling.raw_pairs[2] @ model.C)[data["pairs"]]
-    jet = model.pair_derivatives(data["u_nodes"], model.coupling, data["kept"],
+    kernel = (data["coupling"].raw_pairs[2] @ model.C)[data["pairs"]]
+    jet = model.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
                                  with_hessian=False)["value"] @ model.C
     scale = problem.mesh.comm.allreduce(float(np.max(np.abs(kernel), initial=0.0)), op=MPI.MAX)
     error = problem.mesh.comm.allreduce(float(np.max(np.abs(kernel - jet), initial=0.0)),
@@ -175,8 +175,8 @@ def test_current_mortar_3d_is_the_kernel_and_its_exact_derivatives(kind, scaling
     state = problem.contact.evaluate()
     model = problem.gap_model
     data = state.data.gap_data
-    kernel = (model.coupling.raw_pairs[2] @ model.C)[data["pairs"]]
-    jet = model.pair_derivatives(data["u_nodes"], model.coupling, data["kept"],
+    kernel = (data["coupling"].raw_pairs[2] @ model.C)[data["pairs"]]
+    jet = model.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
                                  with_hessian=False)["value"] @ model.C
     comm = problem.mesh.comm
     scale = comm.allreduce(float(np.max(np.abs(kernel), initial=0.0)), op=MPI.MAX)

@@ -47,8 +47,8 @@ def test_kernel_positive_part_is_the_points_sum():
     state = problem.contact.evaluate()
     model = problem.gap_model
     data = state.data.gap_data
-    points = model.coupling.points
-    expected = np.zeros((len(model.coupling.pairs), model.slave.cells.shape[1]))
+    points = data["coupling"].points
+    expected = np.zeros((len(data["coupling"].pairs), model.slave.cells.shape[1]))
     np.add.at(expected, points["pairs"],
               (points["weights"] * np.maximum(points["gap"], 0.0))[:, None] * points["slave_N"])
     kernel = model.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
@@ -59,7 +59,7 @@ def test_kernel_positive_part_is_the_points_sum():
                                         initial=0.0)), op=MPI.MAX)
     assert scale > 0 and error <= 1e-12 * scale
     # every pair with a penetrating point got derivatives
-    penetrating = np.zeros(len(model.coupling.pairs), dtype=bool)
+    penetrating = np.zeros(len(data["coupling"].pairs), dtype=bool)
     penetrating[points["pairs"][points["gap"] > 0]] = True
     assert np.all(data["kept"][penetrating])
 
@@ -71,9 +71,8 @@ def test_current_pointwise_is_the_nodal_model_where_everything_penetrates(kind):
     pointwise = sheared_blocks(kind, active_set="pointwise", push=0.02)
     nodal = sheared_blocks(kind, push=0.02,
                            mesh_and_tags=(pointwise.mesh, pointwise.facet_tags))
-    model = pointwise.gap_model
-    pointwise.contact.evaluate()
-    points = model.coupling.points
+    state = pointwise.contact.evaluate()
+    points = state.data.gap_data["coupling"].points
     comm = pointwise.mesh.comm
     assert comm.allreduce(int(np.sum(points["gap"] <= 0))) == 0
     r_p, r_n = _residual(pointwise), _residual(nodal)

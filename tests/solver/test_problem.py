@@ -501,7 +501,7 @@ def test_gls_first_touch_starts_from_the_closed_gap(kind):
 
     def counted(snes, x, *predictor):
         outcome = newton(snes, x, *predictor)
-        attempts.append(outcome[2])
+        attempts.append(outcome.iterations)
         return outcome
     problem.solver.newton_step = counted
     result = problem.solve(load_steps=2)
