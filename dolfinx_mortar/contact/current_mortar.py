@@ -25,7 +25,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.contact.active_set import NEAR_CONTACT
-from dolfinx_mortar.contact.finite_deformation import CurrentSurfaceGap
+from dolfinx_mortar.contact.finite_deformation import CurrentSurfaceGap, SourceGaps
 from dolfinx_mortar.contact.penalty_law import PenaltyLaw, safe_weights
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
@@ -139,8 +139,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
             node_weights=node_weights)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
-    def _gap(self, u_nodes: FloatArray, e: dict
-             ) -> tuple[FloatArray, PETSc.Mat, dict, npt.NDArray[np.bool_]]:
+    def _gap(self, u_nodes: FloatArray, W: FloatArray,
+             surface: _kernels.SurfaceCellDerivatives) -> SourceGaps:
         slave, layout = self.slave, self.slave.layout
         # the pairs are found again at every evaluation, and only those near
         # contact matter: each facet searches two of its own diameters
@@ -155,7 +155,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # the values of every pair from the double kernel; derivatives only
         # where a node may carry contact force or stiffness
         g = layout.sum_at_functions(all_cells, coupling.raw_pairs[2] @ self.C)
-        near = self.near_contact(g, self._lumped_weights(e))
+        near = self.near_contact(g, W)
         if self.pointwise:
             # every node with a penetrating point in its support has ĝ⁺ ≠ 0,
             # whatever its mean gap: its pairs need derivatives too (decided
@@ -169,6 +169,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
         ns = cells.shape[1]
         data = {"cells": cells, "pairs": np.flatnonzero(kept), "u_nodes": u_nodes,
                 "coupling": coupling, "kept": kept}
+        g_plus = G_g_plus = None
         # the residual needs gradients only; _gap_hessian asks for the Hessians
         # when (and if) a Jacobian is assembled at this u
         if self.pointwise:
@@ -181,10 +182,10 @@ class CurrentMortarGap(CurrentSurfaceGap):
             grad = np.einsum("pbn,ba->pan", r["gradient"].reshape(len(cells), ns, nv), self.C)
             G_g = assemble_blocks(layout, cells, self.dofs, dofs, grad)
             # ĝ⁺ from the kept pairs: every pair with a penetrating point is kept
-            data["g_plus"] = layout.sum_at_functions(cells, r["value_plus"] @ self.C)
+            g_plus = layout.sum_at_functions(cells, r["value_plus"] @ self.C)
             grad_plus = np.einsum("pbn,ba->pan",
                                   r["gradient_plus"].reshape(len(cells), ns, nv), self.C)
-            data["G_g_plus"] = assemble_blocks(layout, cells, self.dofs, dofs, grad_plus)
+            G_g_plus = assemble_blocks(layout, cells, self.dofs, dofs, grad_plus)
         else:
             # the gradients are shared out over the ranks like the Hessians
             # (_gap_hessian): 25 times the cost of the values, where the
@@ -199,7 +200,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
             G_g = assemble_global_blocks(layout, self._gathered_slave_ids[pairs[:, 0]], dofs,
                                          grad, cols=self.dofs)
         data["dofs"] = dofs
-        return g, G_g, data, layout.on_cells(all_cells)
+        return SourceGaps(g, G_g, layout.on_cells(all_cells), g_plus, G_g_plus, data)
 
     def near_contact(self, g: FloatArray, W: FloatArray) -> npt.NDArray[np.bool_]:
         """Nodes whose gap derivatives are needed: those that may get contact
@@ -226,7 +227,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
         return (nodes[..., None] * gdim + np.arange(gdim)).reshape(num_pairs,
                                                                    nodes.shape[1] * gdim)
 
-    def _gap_hessian(self, data: dict, Fg: Optional[FloatArray]) -> PETSc.Mat:
+    def _gap_hessian(self, source: SourceGaps, Fg: Optional[FloatArray]) -> PETSc.Mat:
+        data = source.data
         dofs = data["dofs"]
         if Fg is None:
             # the pattern: each kept pair's variables couple with each other

@@ -13,7 +13,15 @@ k = 1 for the others, m = 0). C is the identity for LmLS/LmLS* and
 ``L_ref⁻¹ diag(W_ref)`` for the dual kinds — exact on affine facets only, so
 the dual kinds need P1 lines or triangles here. The residual is ∂Π/∂u and
 the Jacobian its exact second derivative, including the variation of the
-area element (``∂J/∂F = J F G⁻¹`` with ``G = FᵀF``) and of W.
+area element and of W.
+
+The derivatives are not written here: the area element, W and an obstacle's
+gap are one templated C++ function of the cell's node coordinates
+(``kernels/include/dolfinx_mortar/current_surface.h``), and its Jet
+instantiation gives their exact gradients and Hessians, as the pair kernel
+does for a master's gap; the law's derivatives in ĝ and W are
+:class:`~dolfinx_mortar.contact.penalty_law.PenaltyLaw`'s. This module
+assembles them.
 
 :class:`CurrentSurfaceGap` holds what does not depend on where the gap comes
 from (W, the nodal energy, residual and Jacobian assembly);
@@ -24,13 +32,14 @@ master. GLS/GLS* (L depends on u through every facet) are not covered.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional
+from typing import Any, Optional
 
 import basix
 import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
+from dolfinx_mortar import _kernels
 from dolfinx_mortar.contact.gaps import GapModelBase
 from dolfinx_mortar.contact.penalty_law import PenaltyLaw, safe_weights
 from dolfinx_mortar.contact.state import ContactState
@@ -38,38 +47,39 @@ from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, is_global, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
-from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.sparse_products import transpose_mat_mult
 
 FloatArray = npt.NDArray[np.float64]
 
 
 
-def area_element_derivatives(F: FloatArray, second: bool = True
-                             ) -> tuple[FloatArray, FloatArray, Optional[FloatArray]]:
-    """``J = sqrt(det FᵀF)`` and its first and second derivatives with respect to F.
+@dataclass
+class ObstaclePoints:
+    """A rigid obstacle's gap ``d = −φ(x)`` at the quadrature points of every
+    slave cell, with its derivatives with respect to the point."""
 
-    ``F``: (..., gdim, tdim). Returns J (...), dJ (..., gdim, tdim) and
-    d2J (..., gdim, tdim, gdim, tdim), or None for d2J unless ``second``.
-    With ``P = F G⁻¹``:
-    ``∂J/∂F_ia = J P_ia`` and
-    ``∂²J/∂F_ia∂F_jb = J (P_ia P_jb + δ_ij G⁻¹_ab − P_ib P_ja − (P Fᵀ)_ij G⁻¹_ab)``.
-    """
-    G = np.einsum("...ia,...ib->...ab", F, F)
-    Ginv = np.linalg.inv(G)
-    J = np.sqrt(np.linalg.det(G))
-    P = F @ Ginv
-    dJ = J[..., None, None] * P
-    if not second:
-        return J, dJ, None
-    gdim = F.shape[-2]
-    delta = np.eye(gdim)
-    PF = np.einsum("...ia,...ja->...ij", P, F)
-    d2J = (np.einsum("...ia,...jb->...iajb", P, P)
-           + np.einsum("ij,...ab->...iajb", delta, Ginv)
-           - np.einsum("...ib,...ja->...iajb", P, P)
-           - np.einsum("...ij,...ab->...iajb", PF, Ginv))
-    return J, dJ, J[..., None, None, None, None] * d2J
+    d: FloatArray            #: (cells, points)
+    gradient: FloatArray     #: (cells, points, gdim)
+    hessian: FloatArray      #: (cells, points, gdim, gdim)
+
+    def kernel_arguments(self) -> dict:
+        return {"obstacle_d": self.d, "obstacle_gradient": self.gradient,
+                "obstacle_hessian": self.hessian}
+
+
+@dataclass
+class SourceGaps:
+    """What a gap source gives at one displacement: ``ĝ_A`` (summed over
+    ranks), ``∂ĝ/∂u`` (slave rows × dofs, Dirichlet columns not yet dropped),
+    the pointwise set's ``ĝ⁺`` and ``∂ĝ⁺/∂u`` (None with the nodal set), the
+    slave nodes with something to touch, and what its Hessian needs."""
+
+    g: FloatArray
+    G_g: PETSc.Mat
+    covered: npt.NDArray[np.bool_]
+    g_plus: Optional[FloatArray] = None
+    G_g_plus: Optional[PETSc.Mat] = None
+    data: Any = None
 
 
 @dataclass
@@ -85,10 +95,10 @@ class CurrentState:
     residual: PETSc.Vec      #: ∂Π/∂u
     Fg: FloatArray           #: ∂F/∂ĝ_A at the local nodes
     FW: FloatArray           #: ∂F/∂W_A at the local nodes
-    element: dict            #: area-element arrays the second derivatives of W need
-    gap_data: object         #: what the gap's source needs for Σ_A F_g,A ∂²ĝ_A
+    x: FloatArray            #: (cells, nodes, gdim) the slave cells' current nodes
+    obstacle: Optional[ObstaclePoints]  #: an obstacle's gap at their points
+    source: SourceGaps       #: what the gap's source gave
     weights: FloatArray      #: ω = ε W^m on the current surface
-    covered: npt.NDArray[np.bool_]  #: slave nodes with something to touch at this u
     coefficients: FloatArray  #: M̄ = φ W^{−k} on every slave cell (the traction's)
     #: pointwise active set: y⁺ = ĝ⁺ W^{−k} with ĝ⁺_A = ∫ φ_A ⟨d⟩ da, and ∂y⁺/∂u
     y_plus: Optional[FloatArray] = None
@@ -162,70 +172,55 @@ class CurrentSurfaceGap(GapModelBase):
         self.cell_dofs = self.node_dofs(cells).reshape(nc, nd * gdim)
 
     # -- what a gap source provides ------------------------------------------------------
-    def _gap(self, u_nodes: FloatArray, e: dict
-             ) -> tuple[FloatArray, PETSc.Mat, object, npt.NDArray[np.bool_]]:
-        """``ĝ_A`` at the local nodes (summed over ranks), ``∂ĝ/∂u`` (slave rows ×
-        dofs, Dirichlet columns not yet dropped), data for :meth:`_gap_hessian`
-        (with :attr:`pointwise` also ``"g_plus"``, ĝ⁺ summed over ranks, and
-        ``"G_g_plus"``, ∂ĝ⁺/∂u) and the slave nodes with something to touch at u."""
+    def _obstacle_at(self, points: FloatArray) -> Optional[ObstaclePoints]:
+        """A rigid obstacle's gap at the cells' current quadrature points
+        (cells, points, gdim); None where the gap comes from a master."""
+        return None
+
+    def _gap(self, u_nodes: FloatArray, W: FloatArray,
+             cells: _kernels.SurfaceCellDerivatives) -> SourceGaps:
+        """The gaps at ``u_nodes`` (local nodes); ``W`` the lumped weights there and
+        ``cells`` the kernel's cell quantities (with the obstacle's gaps)."""
         raise NotImplementedError
 
-    def _gap_hessian(self, data: object, Fg: Optional[FloatArray]) -> PETSc.Mat:
-        """``Σ_A F_g,A ∂²ĝ_A/∂u²`` (dofs × dofs, Dirichlet rows not yet dropped);
-        ``Fg=None``: a matrix with every entry it may have (values arbitrary)."""
-        raise NotImplementedError
+    def _gap_hessian(self, source: SourceGaps, Fg: Optional[FloatArray]) -> Optional[PETSc.Mat]:
+        """``Σ_A F_g,A ∂²ĝ_A/∂u²`` where it does not come with the cells' own
+        (dofs × dofs, Dirichlet rows not yet dropped); ``Fg=None``: a matrix
+        with every entry it may have (values arbitrary). None: nothing beyond
+        the cells'."""
+        return None
 
-    # -- element quantities ------------------------------------------------------------
-    def _elements(self, u_nodes: FloatArray) -> dict:
-        """Area element J of every slave cell at the quadrature points, with its
-        first derivatives with respect to the cell's node positions; the second
-        ones on demand (:meth:`_element_hessians`: a residual needs none, and
-        they were 17% of the current configuration's contact work)."""
-        x = (self.slave.x + u_nodes)[self.slave.cells]              # (c, nd, gdim)
-        F = np.einsum("cbi,qab->cqia", x, self.dN)                  # (c, q, gdim, tdim)
-        J, dJdF, _ = area_element_derivatives(F, second=False)
-        # chain rule through F = Σ_b x_b ⊗ ∇N_b
-        dJ = np.einsum("cqia,qab->cqbi", dJdF, self.dN)             # (c, q, nd, gdim)
-        xq = np.einsum("qb,cbi->cqi", self.N, x)
-        e = {"F": F, "x": xq, "J": J, "dJ": dJ}
-        if self.slave.axisymmetric:
-            R, dR = self._revolution(xq)
-            e["meridian_dJ"] = dJ                          # of J before the factor 2πr
-            e["J"] = J * R
-            e["dJ"] = dJ * R[..., None, None] + J[..., None, None] * dR[None]
-        return e
+    # -- cell quantities ---------------------------------------------------------------
+    def _cells_at(self, u_nodes: FloatArray
+                  ) -> tuple[FloatArray, Optional[ObstaclePoints],
+                             _kernels.SurfaceCellDerivatives]:
+        """The slave cells' current nodes, an obstacle's gap at their points, and
+        W = ∫ N_a J (with an obstacle also ĝ = ∫ φ_a J d) of every cell with
+        exact gradients (the kernels' Jets; the Hessians on demand, in
+        :meth:`_cell_hessians`)."""
+        x = np.ascontiguousarray((self.slave.x + u_nodes)[self.slave.cells])
+        obstacle = self._obstacle_at(np.einsum("qb,cbi->cqi", self.N, x))
+        extra = obstacle.kernel_arguments() if obstacle is not None else {}
+        cells = _kernels.current_surface_cells(
+            x, self.N, self.dN, self.wq, self.phi, self.slave.axisymmetric,
+            positive_part=self.pointwise and obstacle is not None, **extra)
+        return x, obstacle, cells
 
-    def _element_hessians(self, e: dict) -> FloatArray:
-        """∂²J of :meth:`_elements`' ``e`` (c, q, nd, gdim, nd, gdim), computed
-        once and kept in ``e``."""
-        if "d2J" not in e:
-            _, _, d2JdF = area_element_derivatives(e["F"])
-            d2J = np.einsum("nqiajc,qab,qce->nqbiej", d2JdF, self.dN, self.dN,
-                            optimize=True)
-            if self.slave.axisymmetric:
-                # (J R)'' = J'' R + J' ⊗ R' + R' ⊗ J' (R is linear in the nodes)
-                R, dR = self._revolution(e["x"])
-                dJ = e["meridian_dJ"]
-                d2J = (d2J * R[..., None, None, None, None]
-                       + np.einsum("cqbi,qej->cqbiej", dJ, dR)
-                       + np.einsum("qbi,cqej->cqbiej", dR, dJ))
-            e["d2J"] = d2J
-        return e["d2J"]
+    def _cell_hessians(self, x: FloatArray, obstacle: Optional[ObstaclePoints],
+                       FW: FloatArray, Fg: FloatArray) -> FloatArray:
+        """``Σ_a F_W,a ∂²W_a (+ F_g,a ∂²ĝ_a against an obstacle)`` of every
+        cell, (cells, variables, variables)."""
+        cells = self.slave.cells
+        extra = {}
+        if obstacle is not None:
+            extra = {**obstacle.kernel_arguments(), "gap_weights": Fg[cells]}
+        return _kernels.current_surface_hessians(
+            x, self.N, self.dN, self.wq, self.phi, FW[cells], self.slave.axisymmetric,
+            **extra)
 
-    def _revolution(self, xq: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """The factor 2πr of an (r, z) meridian's surface of revolution at each
-        point, ``r = Σ_b N_b x_b,r`` (clamped at 0 as in
-        :meth:`LagrangeSurface.radial_factor`: an axis node may sit at −1e-17),
-        and its derivative with respect to the cell's nodes (q, nd, gdim)."""
-        R = 2 * np.pi * np.maximum(xq[..., 0], 0.0)                 # (c, q)
-        dR = np.zeros(self.N.shape + (self.slave.gdim,))            # (q, nd, gdim)
-        dR[..., 0] = 2 * np.pi * self.N
-        return R, dR
-
-    def _lumped_weights(self, e: dict) -> FloatArray:
-        """``W_A = ∫ N_A da`` on the surface of the element quantities ``e``."""
-        return self.slave.layout.sum_at_functions(
-            self.slave.cells, np.einsum("cq,qa->ca", self.wq[None, :] * e["J"], self.N))
+    def _lumped_weights(self, cells: _kernels.SurfaceCellDerivatives) -> FloatArray:
+        """``W_A = ∫ N_A da`` summed at the nodes."""
+        return self.slave.layout.sum_at_functions(self.slave.cells, cells.W)
 
     def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
         """The contact state at the displacement Function ``u``
@@ -235,7 +230,7 @@ class CurrentSurfaceGap(GapModelBase):
                             self.law.force(current.weights, current.y, current.y_plus),
                             current.residual, gaps_plus=current.y_plus,
                             G_plus=current.G_y_plus, data=current, weights=current.weights,
-                            lumped_weights=current.W, covered=current.covered,
+                            lumped_weights=current.W, covered=current.source.covered,
                             coefficients=current.coefficients)
 
     def evaluate_nodes(self, u_nodes: FloatArray, mask: Optional[PETSc.Vec]) -> CurrentState:
@@ -246,16 +241,13 @@ class CurrentSurfaceGap(GapModelBase):
         # a trial point that collapses a facet is refused by name, not by a
         # singular metric inside the area element
         self.slave.check_displaced(u_nodes)
-        e = self._elements(u_nodes)
+        x, obstacle, surface = self._cells_at(u_nodes)
         cells, layout = self.slave.cells, self.slave.layout
         nc, nd = cells.shape
-        gdim = self.slave.gdim
-        g, G_g, gap_data, covered = self._gap(u_nodes, e)
-        W = self._lumped_weights(e)
-        dW_c = np.einsum("q,qa,cqbi->cabi", self.wq, self.N, e["dJ"])
-        G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
-                              dW_c.reshape(nc, nd, nd * gdim))
-        G_g_plus = gap_data["G_g_plus"] if self.pointwise else None
+        W = self._lumped_weights(surface)
+        G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs, surface.W_gradient)
+        source = self._gap(u_nodes, W, surface)
+        g, G_g, G_g_plus = source.g, source.G_g, source.G_g_plus
         if mask is not None:
             G_g.diagonalScale(None, mask)
             G_W.diagonalScale(None, mask)
@@ -266,7 +258,7 @@ class CurrentSurfaceGap(GapModelBase):
         y_plus = G_y_plus = None
         if self.pointwise:
             # the nodal virtual work with ⟨y⟩ replaced by y⁺ (see the class)
-            y_plus = law.nodal_gaps(gap_data["g_plus"], Wsafe)
+            y_plus = law.nodal_gaps(source.g_plus, Wsafe)
             Fg, FW = law.pointwise_coefficients(y_plus, Wsafe)[:2]
             G_y_plus = self._nodal_gap_derivative(G_g_plus, G_W, y_plus, Wsafe)
         residual = G_g.createVecRight()
@@ -278,8 +270,8 @@ class CurrentSurfaceGap(GapModelBase):
         # M̄ = φ W^{-k}: the functions whose integrals are the nodal gaps y
         coefficients = law.nodal_gaps(np.broadcast_to(self.C, (nc, nd, nd)),
                                       Wsafe[cells][:, None, :])
-        return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, e, gap_data,
-                            law.weights(Wsafe), covered, coefficients, y_plus, G_y_plus)
+        return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, x, obstacle, source,
+                            law.weights(Wsafe), coefficients, y_plus, G_y_plus)
 
     def _nodal_gap_derivative(self, G_g: PETSc.Mat, G_W: PETSc.Mat, y: FloatArray,
                               Wsafe: FloatArray) -> PETSc.Mat:
@@ -347,17 +339,18 @@ class CurrentSurfaceGap(GapModelBase):
             right.axpy(1.0, scaled(state.G_W, FWW), structure=Different)
         K = transpose_mat_mult(state.G_g, left)
         K.axpy(1.0, transpose_mat_mult(state.G_W, right), structure=Different)
-        # second derivatives: Σ_A F_W,A ∂²W_A here, Σ_A F_g,A ∂²ĝ_A from the source
-        cells = self.slave.cells
-        nc, nd = cells.shape
-        width = nd * self.slave.gdim
-        b = np.einsum("ca,qa->cq", state.FW[cells], self.N)
-        blocks = np.einsum("cq,cqbiej->cbiej", self.wq[None, :] * b,
-                           self._element_hessians(state.element))
+        # second derivatives: Σ_A F_W,A ∂²W_A (and an obstacle's Σ_A F_g,A ∂²ĝ_A)
+        # from the cells, a master's Σ_A F_g,A ∂²ĝ_A from the pairs
+        if structure_only:
+            width = self.cell_dofs.shape[1]
+            blocks = np.zeros((len(self.cell_dofs), width, width))
+        else:
+            blocks = self._cell_hessians(state.x, state.obstacle, state.FW, state.Fg)
         K_el = assemble_blocks(self.dofs, self.cell_dofs_local, self.dofs, self.cell_dofs,
-                               blocks.reshape(nc, width, width))
-        K_el.axpy(1.0, self._gap_hessian(state.gap_data, None if structure_only else state.Fg),
-                  structure=Different)
+                               blocks)
+        pairs = self._gap_hessian(state.source, None if structure_only else state.Fg)
+        if pairs is not None:
+            K_el.axpy(1.0, pairs, structure=Different)
         if mask is not None:
             K_el.diagonalScale(mask, mask)
             K.diagonalScale(mask, mask)
@@ -370,73 +363,10 @@ class CurrentSurfaceGap(GapModelBase):
 
     def energy(self, u_nodes: FloatArray) -> float:
         """Π_c summed over all ranks (for checking the residual)."""
-        e = self._elements(u_nodes)
-        g = self._gap(u_nodes, e)[0]
-        W = safe_weights(self._lumped_weights(e))
+        _, _, surface = self._cells_at(u_nodes)
+        W = self._lumped_weights(surface)
+        g = self._gap(u_nodes, W, surface).g
+        W = safe_weights(W)
         n = self.slave.layout.num_owned
         local = np.sum(self.law.energy(g, W)[:n])
         return float(self.slave.layout.comm.allreduce(local))
-
-
-
-class CurrentObstacleGap(CurrentSurfaceGap):
-    """Penalty contact with a rigid obstacle, bases on the current surface.
-
-    ``d = −φ(x + u)`` with φ the obstacle's exact signed distance, integrated
-    with the slave cell's own rule. Parameters as for
-    :class:`CurrentSurfaceGap`, plus the ``obstacle``.
-    """
-
-    def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, kind: BasisKind,
-                 law: PenaltyLaw, quadrature_degree=None):
-        if obstacle.gdim != slave.gdim:
-            raise ValueError(f"a {obstacle.gdim}D obstacle cannot touch a {slave.gdim}D body")
-        super().__init__(slave, kind, law, quadrature_degree)
-        self.obstacle = obstacle
-
-    def _gap(self, u_nodes: FloatArray, e: dict
-             ) -> tuple[FloatArray, PETSc.Mat, dict, npt.NDArray[np.bool_]]:
-        cells, layout = self.slave.cells, self.slave.layout
-        nc, nd = cells.shape
-        gdim = self.slave.gdim
-        flat = e["x"].reshape(-1, gdim)
-        nq = e["x"].shape[1]
-        d = -self.obstacle.signed_distance(flat).reshape(nc, nq)
-        grad = -self.obstacle.gradient(flat).reshape(nc, nq, gdim)
-        hess = -self.obstacle.hessian(flat).reshape(nc, nq, gdim, gdim)
-        wJ = self.wq[None, :] * e["J"]
-        g = layout.sum_at_functions(cells, np.einsum("cq,qa->ca", wJ * d, self.phi))
-        v = np.einsum("cqi,qb->cqbi", grad, self.N)                 # ∇d_i N_b
-        dg_c = (np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, d, e["dJ"])
-                + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, e["J"], v))
-        G_g = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
-                              dg_c.reshape(nc, nd, nd * gdim))
-        data = {"e": e, "d": d, "v": v, "hess": hess}
-        if self.pointwise:
-            # ⟨d⟩ and its derivative H(d)∇d at the same points (not split at d = 0)
-            penetrating = d > 0
-            dp = np.where(penetrating, d, 0.0)
-            data["g_plus"] = layout.sum_at_functions(
-                cells, np.einsum("cq,qa->ca", wJ * dp, self.phi))
-            dgp_c = (np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi, dp, e["dJ"])
-                     + np.einsum("q,qa,cq,cqbi->cabi", self.wq, self.phi,
-                                 e["J"] * penetrating, v))
-            data["G_g_plus"] = assemble_blocks(layout, cells, self.dofs, self.cell_dofs,
-                                               dgp_c.reshape(nc, nd, nd * gdim))
-        return g, G_g, data, self.covered
-
-    def _gap_hessian(self, data: dict, Fg: Optional[FloatArray]) -> PETSc.Mat:
-        e, d, v = data["e"], data["d"], data["v"]
-        if Fg is None:                      # the pattern: every cell's block
-            Fg = np.ones(self.slave.layout.size_local)
-        cells = self.slave.cells
-        nc, nd = cells.shape
-        width = nd * self.slave.gdim
-        wa = self.wq[None, :] * np.einsum("ca,qa->cq", Fg[cells], self.phi)
-        blocks = (np.einsum("cq,cqbiej->cbiej", wa * d, self._element_hessians(e))
-                  + np.einsum("cq,cqbi,cqej->cbiej", wa, e["dJ"], v)
-                  + np.einsum("cq,cqbi,cqej->cbiej", wa, v, e["dJ"])
-                  + np.einsum("cq,cq,cqij,qb,qe->cbiej", wa, e["J"], data["hess"], self.N,
-                              self.N))
-        return assemble_blocks(self.dofs, self.cell_dofs_local, self.dofs, self.cell_dofs,
-                               blocks.reshape(nc, width, width))

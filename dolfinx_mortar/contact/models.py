@@ -14,7 +14,7 @@ import numpy.typing as npt
 from mpi4py import MPI
 
 from dolfinx_mortar.contact.current_mortar import CurrentMortarGap
-from dolfinx_mortar.contact.finite_deformation import CurrentObstacleGap
+from dolfinx_mortar.contact.current_obstacle import CurrentObstacleGap
 from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
 from dolfinx_mortar.contact.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle

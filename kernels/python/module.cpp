@@ -12,6 +12,8 @@
 #include <dolfinx_mortar/mortar_integrals.h>
 #include <dolfinx_mortar/surface_geometry.h>
 
+#include "bindings.h"
+
 #include <optional>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -22,46 +24,10 @@
 
 namespace py = pybind11;
 using namespace dolfinx_mortar;
+using namespace dolfinx_mortar::bindings;
 
 namespace
 {
-using array_t = py::array_t<double, py::array::c_style | py::array::forcecast>;
-using int_array_t =
-  py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>;
-using int64_array_t =
-  py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
-
-template<typename T>
-py::array_t<T>
-to_numpy_as(const std::vector<T>& v, std::vector<py::ssize_t> shape)
-{
-  return py::array_t<T>(shape, v.data());
-}
-
-/// A FacetSurface viewing numpy arrays that the caller keeps alive.
-FacetSurface
-surface_view(FacetType type, const array_t& x, const int_array_t& cells)
-{
-  if (x.ndim() != 2 or cells.ndim() != 2)
-    throw std::invalid_argument(
-      "x must be (nodes, gdim), cells (cells, nodes)");
-  if (cells.shape(1) != facet_num_nodes(type))
-    throw std::invalid_argument(to_string(type) + " cells need " +
-                                std::to_string(facet_num_nodes(type)) +
-                                " nodes");
-  return FacetSurface{ type,
-                       static_cast<int>(x.shape(1)),
-                       std::span<const double>(x.data(), x.size()),
-                       std::span<const std::int32_t>(cells.data(),
-                                                     cells.size()) };
-}
-
-std::span<const double>
-as_span(const array_t& a)
-{
-  return std::span<const double>(a.data(), static_cast<std::size_t>(a.size()));
-}
-
 TabulationShape
 tabulation_shape(const array_t& phi, const array_t& weights)
 {
@@ -77,18 +43,12 @@ tabulation_shape(const array_t& phi, const array_t& weights)
            static_cast<std::size_t>(phi.shape(2)) };
 }
 
-// One copy into numpy-owned memory: cheap next to the kernel work, and it
-// keeps ownership simple.
-array_t
-to_numpy(const std::vector<double>& v, std::vector<py::ssize_t> shape)
-{
-  return array_t(shape, v.data());
-}
 } // namespace
 
 PYBIND11_MODULE(_kernels, m)
 {
   m.doc() = "dolfinx_mortar C++ kernels";
+  bind_current_surface(m);
 
   m.attr("geometric_tolerance") = geometric_tolerance;
   m.def(

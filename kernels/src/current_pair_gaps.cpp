@@ -1,7 +1,7 @@
 // Copyright (C) 2026 dolfinx_mortar developers
 // SPDX-License-Identifier: MIT
 #include <dolfinx_mortar/current_pair_gaps.h>
-#include <dolfinx_mortar/pair_segmentation.h>
+#include <dolfinx_mortar/piece_quadrature.h>
 
 #include <algorithm>
 #include <stdexcept>

@@ -2,7 +2,7 @@
 // SPDX-License-Identifier: MIT
 #include <dolfinx_mortar/geometric_tolerance.h>
 #include <dolfinx_mortar/mortar_integrals.h>
-#include <dolfinx_mortar/pair_segmentation.h>
+#include <dolfinx_mortar/piece_quadrature.h>
 
 #include <algorithm>
 #include <cmath>

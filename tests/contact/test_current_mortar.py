@@ -26,7 +26,7 @@ def test_differentiable_gaps_equal_the_kernels(kind, degree):
     problem = sheared_blocks(kind, degree=degree)
     state = problem.contact.evaluate()
     model = problem.gap_model
-    data = state.data.gap_data
+    data = state.data.source.data
     kernel = (data["coupling"].raw_pairs[2] @ model.C)[data["pairs"]]
     jet = model.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
                                  with_hessian=False)["value"] @ model.C
@@ -174,7 +174,7 @@ def test_current_mortar_3d_is_the_kernel_and_its_exact_derivatives(kind, scaling
     problem = sheared_boxes(kind, scaling)
     state = problem.contact.evaluate()
     model = problem.gap_model
-    data = state.data.gap_data
+    data = state.data.source.data
     kernel = (data["coupling"].raw_pairs[2] @ model.C)[data["pairs"]]
     jet = model.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
                                  with_hessian=False)["value"] @ model.C

@@ -46,7 +46,7 @@ def test_kernel_positive_part_is_the_points_sum():
     problem = sheared_blocks("LmLS", active_set="pointwise")
     state = problem.contact.evaluate()
     model = problem.gap_model
-    data = state.data.gap_data
+    data = state.data.source.data
     points = data["coupling"].points
     expected = np.zeros((len(data["coupling"].pairs), model.slave.cells.shape[1]))
     np.add.at(expected, points["pairs"],
@@ -72,7 +72,7 @@ def test_current_pointwise_is_the_nodal_model_where_everything_penetrates(kind):
     nodal = sheared_blocks(kind, push=0.02,
                            mesh_and_tags=(pointwise.mesh, pointwise.facet_tags))
     state = pointwise.contact.evaluate()
-    points = state.data.gap_data["coupling"].points
+    points = state.data.source.data["coupling"].points
     comm = pointwise.mesh.comm
     assert comm.allreduce(int(np.sum(points["gap"] <= 0))) == 0
     r_p, r_n = _residual(pointwise), _residual(nodal)

@@ -6,7 +6,6 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar.contact.finite_deformation import area_element_derivatives
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactProblem
 from support.jacobian_check import (convergence_order, energy_gradient_error, jacobian_error,
@@ -15,19 +14,72 @@ from support import load_demo
 from support.scenes import LOCAL_KINDS, block_on_plane, pressed_block
 
 
-@pytest.mark.parametrize("shape", [(2, 1), (3, 1), (3, 2)])
-def test_area_element_derivatives_match_differences(shape):
-    F = np.random.default_rng(3).normal(size=shape)
-    J, dJ, d2J = area_element_derivatives(F)
-    assert J == pytest.approx(np.sqrt(np.linalg.det(F.T @ F)))
+def _cell_scene(cell: str, degree: int):
+    """A curved (P2) or straight cell of a surface pressed into a rigid ball, its
+    reference rule and basis, and the obstacle's gap at the points."""
+    import basix
+    from dolfinx_mortar import _kernels
+    cell_type = basix.CellType[cell]
+    X, w = basix.make_quadrature(cell_type, 2 * degree + 2)
+    element = basix.create_element(basix.ElementFamily.P, cell_type, degree,
+                                   basix.LagrangeVariant.gll_warped)
+    tab = element.tabulate(1, X)
+    N, dN = tab[0, :, :, 0], np.moveaxis(tab[1:, :, :, 0], 0, 1)
+    nodes = element.points
+    gdim = nodes.shape[1] + 1
+    rng = np.random.default_rng(4)
+    x = np.zeros((1, len(nodes), gdim))
+    x[0, :, :gdim - 1] = nodes + 0.1 * rng.normal(size=nodes.shape)
+    x[0, :, -1] = 0.05 * rng.normal(size=len(nodes))
+    x[0, :, 0] += 0.5            # a meridian off the axis
+    centre, radius = np.full(gdim, 0.5), 1.0
+    centre[-1] = -0.95
+
+    def obstacle(x):
+        points = np.einsum("qb,cbi->cqi", N, x)
+        r = points - centre
+        s = np.linalg.norm(r, axis=-1)
+        eye = np.eye(gdim)
+        hess = -(eye - np.einsum("cqi,cqj->cqij", r, r) / s[..., None, None] ** 2) / s[
+            ..., None, None]
+        return {"obstacle_d": radius - s, "obstacle_gradient": -r / s[..., None],
+                "obstacle_hessian": hess}
+    return _kernels, x, N, dN, w, obstacle
+
+
+@pytest.mark.parametrize("cell, degree, axisymmetric", [("interval", 1, False),
+                                                         ("interval", 2, False),
+                                                         ("interval", 2, True),
+                                                         ("triangle", 1, False),
+                                                         ("quadrilateral", 1, False)])
+def test_current_surface_cells_derivatives_match_differences(cell, degree, axisymmetric):
+    """The cells' W = ∫ N J and obstacle gaps ∫ φ J d from the kernel's Jets: the
+    gradients against central differences of the values, the weighted Hessian
+    against central differences of the gradients."""
+    kernels, x, N, dN, w, obstacle = _cell_scene(cell, degree)
+    phi = N @ np.linalg.inv(np.eye(N.shape[1]) + 0.2)   # some basis φ = N C
+
+    def cells(x):
+        return kernels.current_surface_cells(x, N, dN, w, phi, axisymmetric, **obstacle(x))
+    r = cells(x)
+    if not axisymmetric and cell == "interval":
+        lengths = np.linalg.norm(np.diff(x[0, :2], axis=0)) if degree == 1 else None
+        if lengths is not None:
+            assert r.W.sum() == pytest.approx(lengths, rel=1e-14)
+    wW, wg = np.linspace(0.5, 1.5, N.shape[1]), np.linspace(-1, 2, N.shape[1])
+    H = kernels.current_surface_hessians(x, N, dN, w, phi, wW[None], axisymmetric,
+                                         gap_weights=wg[None], **obstacle(x))[0]
     h = 1e-6
-    for index in np.ndindex(*shape):
-        E = np.zeros(shape)
-        E[index] = h
-        Jp, dJp, _ = area_element_derivatives(F + E)
-        Jm, dJm, _ = area_element_derivatives(F - E)
-        assert (Jp - Jm) / (2 * h) == pytest.approx(dJ[index], abs=1e-8)
-        assert np.allclose((dJp - dJm) / (2 * h), d2J[(...,) + index], atol=1e-8)
+    flat = x.reshape(-1)
+    for k in range(flat.size):
+        e = np.zeros_like(flat)
+        e[k] = h
+        p, m = cells((flat + e).reshape(x.shape)), cells((flat - e).reshape(x.shape))
+        assert np.allclose((p.W - m.W) / (2 * h), r.W_gradient[..., k], atol=1e-8)
+        assert np.allclose((p.gap - m.gap) / (2 * h), r.gap_gradient[..., k], atol=1e-8)
+        column = (wW @ (p.W_gradient - m.W_gradient)[0] + wg @ (p.gap_gradient
+                                                                 - m.gap_gradient)[0]) / (2 * h)
+        assert np.allclose(column, H[k], atol=1e-7)
 
 
 def _deformed_block(kind, scaling, n=(8, 3)):
