@@ -114,7 +114,7 @@ def main() -> None:
         weights = np.ones((n, scene.cs.shape[1]))
         weighted = median_time(lambda: scene.jets(scene.xs, scene.xm, pairs, True,
                                                   node_weights=weights)) / n
-        width = scene.jets(scene.xs, scene.xm, pairs[:1])["gradient"].shape[2]
+        width = scene.jets(scene.xs, scene.xm, pairs[:1]).gradient.shape[2]
         row = {"facet": kind, "pairs": n, "variables_per_pair": width,
                "values_per_s": 1 / values, "gradients_per_s": 1 / gradients,
                "hessians_per_s": 1 / hessians, "weighted_hessians_per_s": 1 / weighted,

@@ -1,5 +1,5 @@
 """``Gᵀ G`` of the contact operator two ways: PETSc's MatTransposeMatMult, and the library's
-explicit transpose followed by MatMatMult (:func:`dolfinx_mortar.contact.sparse_products.
+explicit transpose followed by MatMatMult (:func:`dolfinx_mortar.linalg.sparse_products.
 transpose_mat_mult`, written for PETSc 3.18, whose MatTransposeMatMult was 7× slower on 2 ranks).
 
     OMP_NUM_THREADS=1 [mpirun -n 2] python3 benchmarks/transpose_product.py [--refine 1]
@@ -17,7 +17,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from demo_support.scripts import load_demo
-from dolfinx_mortar.contact.sparse_products import transpose_mat_mult
+from dolfinx_mortar.linalg.sparse_products import transpose_mat_mult
 
 
 def best_time(product, repeat: int, comm: MPI.Comm) -> tuple[float, PETSc.Mat]:

@@ -13,7 +13,12 @@ Subpackages, one per layer of the Python library:
 - :mod:`~dolfinx_mortar.contact`: gap models, rigid obstacles and the contact
   term that adds penalty contact to a DOLFINx model;
 - :mod:`~dolfinx_mortar.solver`: the nonlinear problem, Newton and the load path;
-- :mod:`~dolfinx_mortar.io`: XDMF series, gmsh, merged meshes, result files;
+- :mod:`~dolfinx_mortar.linalg`: the linear solver's choice, the contact block
+  preconditioner, the near-nullspace, sparse products;
+- :mod:`~dolfinx_mortar.small_strain`: linear elasticity (plane, 3D,
+  axisymmetric) and ``ContactProblem``, the short path;
+- :mod:`~dolfinx_mortar.meshes`: merging two bodies' meshes, the contact partitioner;
+- :mod:`~dolfinx_mortar.io`: XDMF series, gmsh, result files;
 - :mod:`~dolfinx_mortar.kernels`: the C++ kernels (facet geometry,
   segmentation, mortar integrals, basis coefficients).
 
@@ -49,7 +54,7 @@ _LAZY = {
     "NewtonSolver": "dolfinx_mortar.solver.newton_solver",
     "LoadPathSolver": "dolfinx_mortar.solver.load_path",
     "read_xdmf_series": "dolfinx_mortar.io.read_series",
-    "ContactProblem": "dolfinx_mortar.solver.elastic",
+    "ContactProblem": "dolfinx_mortar.small_strain.elastic",
     "ContactDivergenceError": "dolfinx_mortar.solver.convergence",
     "RigidPlane": "dolfinx_mortar.contact.obstacles",
     "RigidSphere": "dolfinx_mortar.contact.obstacles",

@@ -1,5 +1,5 @@
 """The demos' bulk laws beyond small-strain elasticity (the library's own is
-:func:`dolfinx_mortar.solver.elastic.linear_elastic_residual`)."""
+:func:`dolfinx_mortar.small_strain.elastic.linear_elastic_residual`)."""
 from __future__ import annotations
 
 import ufl

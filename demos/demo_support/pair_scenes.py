@@ -107,7 +107,7 @@ class PairScene:
                                       self.kind, xm, self.cm.astype(np.int32),
                                       candidates.astype(np.int32), self.points, self.weights,
                                       True, length_scale=self.length_scale)
-        return r["pairs"], r["gap"]
+        return r.pairs, r.gap
 
     def jets(self, xs, xm, pairs, with_hessian: bool = True, node_weights=None):
         """The Jet instantiation: ``current_pair_gaps`` (per node, or the

@@ -29,7 +29,7 @@ from dolfinx_mortar.contact.models import (current_model, frozen_model, moved,
                                            refuse_false_penetration)
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
-from dolfinx_mortar.contact.sparse_products import PatternTrackingAdd
+from dolfinx_mortar.linalg.sparse_products import PatternTrackingAdd
 from dolfinx_mortar.contact.state import GapModel
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement

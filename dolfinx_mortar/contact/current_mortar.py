@@ -16,6 +16,7 @@ Lines of degree 1 and 2 in 2D; P1 triangles and Q1 quadrilaterals in 3D
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
@@ -52,6 +53,21 @@ def share_evenly(comm: MPI.Comm, *per_pair: npt.NDArray) -> tuple[npt.NDArray, .
     total = comm.allreduce(len(per_pair[0]))
     start, end = total * comm.rank // comm.size, total * (comm.rank + 1) // comm.size
     return tuple(np.concatenate(comm.allgather(np.asarray(a)))[start:end] for a in per_pair)
+
+
+@dataclass
+class KeptPairs:
+    """The pairs of one evaluation whose derivatives were computed: their slave
+    cells, their indices in the coupling's pairs, the displacement and the
+    coupling they were found at, which of the coupling's pairs were kept, and
+    the global dofs of their variables."""
+
+    cells: IntArray
+    pairs: IntArray
+    u_nodes: FloatArray
+    coupling: MortarCoupling
+    kept: npt.NDArray[np.bool_]
+    dofs: Optional[IntArray] = None
 
 
 class CurrentMortarGap(CurrentSurfaceGap):
@@ -101,12 +117,13 @@ class CurrentMortarGap(CurrentSurfaceGap):
     def pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
                          which: Optional[npt.NDArray[np.bool_]] = None,
                          with_hessian: bool = True, with_positive_part: bool = False,
-                         node_weights: Optional[FloatArray] = None) -> dict:
+                         node_weights: Optional[FloatArray] = None
+                         ) -> _kernels.PairGapDerivatives:
         """``c_A = ∫ N_A d`` of the pairs of ``coupling`` (all, or those where
         ``which`` is True) with exact derivatives (the Hessians only with
         ``with_hessian``).
 
-        Returns the kernel's arrays: ``value`` (pairs, ns), ``gradient``
+        Returns the kernel's typed result: ``value`` (pairs, ns), ``gradient``
         (pairs, ns, nv), ``hessian`` (pairs, ns, nv, nv) and ``nodes`` (pairs,
         nv / gdim), the global node ids of the variables (slave cell, other
         slave nodes, master cell; −1 pads); with ``with_positive_part`` also
@@ -122,7 +139,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
     def gathered_pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
                                   gathered_pairs: npt.NDArray[np.int64], with_hessian: bool,
                                   with_positive_part: bool = False,
-                                  node_weights: Optional[FloatArray] = None) -> dict:
+                                  node_weights: Optional[FloatArray] = None
+                                  ) -> _kernels.PairGapDerivatives:
         """:meth:`pair_derivatives` of pairs given in the gathered numbering
         (slave cell of the gathered slave surface, master cell): any rank can
         compute any rank's pairs, as every rank holds both gathered surfaces.
@@ -162,13 +180,12 @@ class CurrentMortarGap(CurrentSurfaceGap):
             # on the points' values, as the kernel's ⟨d⟩ is)
             points = coupling.points
             penetrating = np.zeros(len(coupling.pairs), dtype=bool)
-            penetrating[points["pairs"][points["gap"] > 0]] = True
+            penetrating[points.pairs[points.gap > 0]] = True
             near |= layout.on_cells(all_cells[penetrating])
         kept = np.any(near[all_cells], axis=1)
         cells = all_cells[kept]
         ns = cells.shape[1]
-        data = {"cells": cells, "pairs": np.flatnonzero(kept), "u_nodes": u_nodes,
-                "coupling": coupling, "kept": kept}
+        data = KeptPairs(cells, np.flatnonzero(kept), u_nodes, coupling, kept)
         g_plus = G_g_plus = None
         # the residual needs gradients only; _gap_hessian asks for the Hessians
         # when (and if) a Jacobian is assembled at this u
@@ -177,14 +194,14 @@ class CurrentMortarGap(CurrentSurfaceGap):
             # rank that holds the pairs (not shared out: see _gap_hessian)
             r = self.pair_derivatives(u_nodes, coupling, kept, with_hessian=False,
                                       with_positive_part=True)
-            dofs = self._variable_dofs(r["nodes"], len(cells))
+            dofs = self._variable_dofs(r.nodes, len(cells))
             nv = dofs.shape[1]
-            grad = np.einsum("pbn,ba->pan", r["gradient"].reshape(len(cells), ns, nv), self.C)
+            grad = np.einsum("pbn,ba->pan", r.gradient.reshape(len(cells), ns, nv), self.C)
             G_g = assemble_blocks(layout, cells, self.dofs, dofs, grad)
             # ĝ⁺ from the kept pairs: every pair with a penetrating point is kept
-            g_plus = layout.sum_at_functions(cells, r["value_plus"] @ self.C)
+            g_plus = layout.sum_at_functions(cells, r.value_plus @ self.C)
             grad_plus = np.einsum("pbn,ba->pan",
-                                  r["gradient_plus"].reshape(len(cells), ns, nv), self.C)
+                                  r.gradient_plus.reshape(len(cells), ns, nv), self.C)
             G_g_plus = assemble_blocks(layout, cells, self.dofs, dofs, grad_plus)
         else:
             # the gradients are shared out over the ranks like the Hessians
@@ -193,13 +210,13 @@ class CurrentMortarGap(CurrentSurfaceGap):
             pairs, = share_evenly(layout.comm,
                                   coupling.pairs[kept] + np.array([self._first_cell, 0]))
             r = self.gathered_pair_derivatives(u_nodes, coupling, pairs, with_hessian=False)
-            dofs = self._variable_dofs(r["nodes"], len(pairs))
+            dofs = self._variable_dofs(r.nodes, len(pairs))
             nv = dofs.shape[1]
             # φ_a = Σ_b N_b C_ba
-            grad = np.einsum("pbn,ba->pan", r["gradient"].reshape(len(pairs), ns, nv), self.C)
+            grad = np.einsum("pbn,ba->pan", r.gradient.reshape(len(pairs), ns, nv), self.C)
             G_g = assemble_global_blocks(layout, self._gathered_slave_ids[pairs[:, 0]], dofs,
                                          grad, cols=self.dofs)
-        data["dofs"] = dofs
+        data.dofs = dofs
         return SourceGaps(g, G_g, layout.on_cells(all_cells), g_plus, G_g_plus, data)
 
     def near_contact(self, g: FloatArray, W: FloatArray) -> npt.NDArray[np.bool_]:
@@ -229,12 +246,12 @@ class CurrentMortarGap(CurrentSurfaceGap):
 
     def _gap_hessian(self, source: SourceGaps, Fg: Optional[FloatArray]) -> PETSc.Mat:
         data = source.data
-        dofs = data["dofs"]
+        dofs = data.dofs
         if Fg is None:
             # the pattern: each kept pair's variables couple with each other
             blocks = np.zeros((len(dofs), dofs.shape[1], dofs.shape[1]))
             return assemble_global_blocks(self.dofs, dofs, dofs, blocks)
-        cells = data["cells"]
+        cells = data.cells
         # Σ_a F_g,a ∂²ĝ_a = Σ_b (C F_g)_b ∂²c_b (C applied to the weights, a
         # small product, instead of to the Hessians)
         weights = Fg[cells] @ self.C.T
@@ -245,7 +262,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # (100-200 times the cost of its values) is skipped. On Hertz 3D these
         # are most of the pairs kept for the gradients.
         needed = np.any(Fg[cells] != 0.0, axis=1)
-        pairs = (data["coupling"].pairs[data["pairs"][needed]]
+        pairs = (data.coupling.pairs[data.pairs[needed]]
                  + np.array([self._first_cell, 0]))
         # The Hessians are most of the contact work, and they sit where the
         # surfaces press, often on one rank. Every rank holds both gathered
@@ -253,9 +270,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # an equal share of all ranks' pairs instead of its own.
         pairs, weights = share_evenly(self.slave.layout.comm, pairs, weights[needed])
         # the kernel sums the weighted Hessians (one per pair, not ns)
-        r = self.gathered_pair_derivatives(data["u_nodes"], data["coupling"], pairs,
+        r = self.gathered_pair_derivatives(data.u_nodes, data.coupling, pairs,
                                            with_hessian=True, node_weights=weights)
         n = len(pairs)
-        dofs = self._variable_dofs(r["nodes"], n)
+        dofs = self._variable_dofs(r.nodes, n)
         nv = dofs.shape[1]
-        return assemble_global_blocks(self.dofs, dofs, dofs, r["hessian"].reshape(n, nv, nv))
+        return assemble_global_blocks(self.dofs, dofs, dofs, r.hessian.reshape(n, nv, nv))

@@ -47,7 +47,7 @@ from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, is_global, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
-from dolfinx_mortar.contact.sparse_products import transpose_mat_mult
+from dolfinx_mortar.linalg.sparse_products import transpose_mat_mult
 
 FloatArray = npt.NDArray[np.float64]
 

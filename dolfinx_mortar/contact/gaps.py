@@ -39,7 +39,7 @@ from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.pointwise import MortarPointGaps, obstacle_positive_gaps
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
-from dolfinx_mortar.contact.sparse_products import TransposeProduct, transpose_mat_mult
+from dolfinx_mortar.linalg.sparse_products import TransposeProduct, transpose_mat_mult
 
 FloatArray = npt.NDArray[np.float64]
 

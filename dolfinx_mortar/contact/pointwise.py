@@ -123,14 +123,14 @@ class MortarPointGaps:
                              "keep_points=True)")
         self.model = model
         pts = coupling.points
-        pair = pts["pairs"].astype(np.int64)
+        pair = pts.pairs.astype(np.int64)
         slave_cell = coupling.pairs[pair, 0]
         master_cells = coupling.master_cells[coupling.pairs[pair, 1]]
         self.rows = model.slave.cells[slave_cell]               # (points, ns)
-        self.d0 = pts["gap"]
-        n = pts["normals"]
+        self.d0 = pts.gap
+        n = pts.normals
         bs = model.slave.gdim
-        Ns, Nm = pts["slave_N"], pts["master_N"]
+        Ns, Nm = pts.slave_N, pts.master_N
         npts = len(self.d0)
         slave_dofs = model.node_dofs(self.rows)
         master_dofs = (coupling.master_global_ids[master_cells][..., None] * bs
@@ -141,7 +141,7 @@ class MortarPointGaps:
                                   -np.einsum("qc,qk->qck", Nm, n)], axis=1).reshape(npts, width)
         self.cols = np.concatenate([slave_dofs, master_dofs], axis=1).reshape(npts, width)
         #: w_q M̄_A(q)
-        self.wM = pts["weights"][:, None] * np.einsum(
+        self.wM = pts.weights[:, None] * np.einsum(
             "qb,qba->qa", Ns, model.coefficients_std[slave_cell])
         points = NodeLayout(model.slave.layout.comm, npts, np.zeros(0, dtype=np.int64))
         self.point_derivative = assemble_blocks(points, np.arange(npts)[:, None], model.dofs,

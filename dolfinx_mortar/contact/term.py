@@ -101,7 +101,7 @@ class ContactTerm(ContactResults):
         radius, y the axis): every contact integral carries 2πr, so that
         forces are those on the whole body (docs/AXISYMMETRIC.md). The user's bulk form
         must be axisymmetric too
-        (:func:`~dolfinx_mortar.solver.elastic.axisymmetric_elastic_residual`).
+        (:func:`~dolfinx_mortar.small_strain.elastic.axisymmetric_elastic_residual`).
     """
 
     def __init__(self, u: fem.Function, facet_tags, slave_tag: int, *,

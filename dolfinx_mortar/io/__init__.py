@@ -1,1 +1,1 @@
-"""Output and input: crash-safe XDMF series, gmsh files, merged meshes, result files."""
+"""Output and input: crash-safe XDMF series, gmsh files, result files."""

@@ -31,7 +31,7 @@ def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: int = 3,
     balance_facets
         Physical tags of the facet groups (the contact surfaces) whose
         adjacent cells every rank should get an equal share of
-        (:func:`~dolfinx_mortar.io.contact_partitioner.contact_balanced_partitioner`).
+        (:func:`~dolfinx_mortar.meshes.contact_partitioner.contact_balanced_partitioner`).
         ``None`` uses DOLFINx's graph partitioner alone.
 
     Returns
@@ -79,7 +79,7 @@ def _contact_cell_partitioner(comm: MPI.Comm, x: Optional[np.ndarray],
     and balances them (:func:`contact_balanced_partitioner`)."""
     from dolfinx import cpp as _cpp
 
-    from dolfinx_mortar.io.contact_partitioner import (cells_near_contact,
+    from dolfinx_mortar.meshes.contact_partitioner import (cells_near_contact,
                                                        contact_balanced_partitioner)
 
     def partition(comm_wrapper, nparts: int, cell_types, cells):

@@ -217,6 +217,25 @@ def segment_quadrature(tdim: int, degree: int) -> tuple[FloatArray, FloatArray]:
     return basix.make_quadrature(cell, degree)
 
 
+@dataclass(frozen=True)
+class SegmentPoints:
+    """The segment quadrature points of a coupling (``keep_points``): for each, its
+    pair (index into the pairs), weight, gap d, unit normal n, and the standard slave
+    basis N and master basis N^m there."""
+
+    pairs: npt.NDArray[np.int32]
+    weights: FloatArray
+    gap: FloatArray
+    normals: FloatArray
+    slave_N: FloatArray
+    master_N: FloatArray
+
+    @classmethod
+    def of(cls, r: "_kernels.MortarIntegrals") -> "SegmentPoints":
+        return cls(r.point_pairs, r.point_weights, r.point_gap, r.point_normals,
+                   r.point_slave_N, r.point_master_N)
+
+
 class MortarCoupling:
     """Segmentation and slave-basis mortar integrals of a slave–master pair.
 
@@ -330,7 +349,8 @@ class MortarCoupling:
                                 length_scale(master_copy.x) if len(master_copy.x) else 0.0)
         #: lengths at or below this are zero (docs/DESIGN.md, §Tolerances)
         self.zero_length = zero_length(self.length_scale)
-        def segment(normals: FloatArray, keep_points: bool, along_normals: bool) -> dict:
+        def segment(normals: FloatArray, keep_points: bool,
+                    along_normals: bool) -> _kernels.MortarIntegrals:
             return _kernels.mortar_integrals(slave.facet_type, xs, slave_cells, normals,
                                              master.facet_type, master_copy.x,
                                              master_copy.cells, candidates, points, weights,
@@ -345,49 +365,48 @@ class MortarCoupling:
             # pairing and gap along the interface normals, not the facets' own
             self._raise_on_degenerate_facets(r, xs, slave_cells, master_copy)
             self.normals = interface_nodal_normals(slave, self.normals, master_copy,
-                                                   r["pairs"], r["area"])
+                                                   r.pairs, r.area)
             r = segment(self.normals, keep_points, True)
         self._raise_on_degenerate_facets(r, xs, slave_cells, master_copy)
         self.timings["segmentation"] = time.perf_counter() - clock
         self.num_candidates = len(candidates)
-        self.failed_projections = comm.allreduce(int(r["failed_projections"]))
+        self.failed_projections = comm.allreduce(int(r.failed_projections))
         #: (pairs, 2) slave cell, master cell (index into the gathered master)
-        self.pairs = r["pairs"].astype(np.int64)
+        self.pairs = r.pairs.astype(np.int64)
         #: integrals of the standard slave basis N per pair: ∫N N, ∫N N^m, ∫N d
-        self.raw_pairs = (r["D"], r["M"], r["gap"])
+        self.raw_pairs = (r.D, r.M, r.gap)
         T = slave.reference.transform
         if T is not None:
             # integrals of the transformed basis Ñ = N T (docs/DESIGN.md, §Quadratic elements)
-            self.D_pairs = np.einsum("ba,pbc,cd->pad", T, r["D"], T)
-            self.M_pairs = np.einsum("ba,pbc->pac", T, r["M"])
-            self.gap_pairs = np.einsum("ba,pb->pa", T, r["gap"])
+            self.D_pairs = np.einsum("ba,pbc,cd->pad", T, r.D, T)
+            self.M_pairs = np.einsum("ba,pbc->pac", T, r.M)
+            self.gap_pairs = np.einsum("ba,pb->pa", T, r.gap)
         else:
-            self.D_pairs, self.M_pairs, self.gap_pairs = r["D"], r["M"], r["gap"]
-        self.area_pairs = r["area"]
+            self.D_pairs, self.M_pairs, self.gap_pairs = r.D, r.M, r.gap
+        self.area_pairs = r.area
         #: per segment quadrature point (keep_points): pair, weight, gap d,
         #: unit normal n, standard slave basis N, master basis N^m; else None
-        self.points: Optional[dict] = (
-            {key[len("point_"):]: r[key] for key in r if key.startswith("point_")}
-            if keep_points else None)
+        self.points: Optional[SegmentPoints] = (SegmentPoints.of(r) if keep_points else None)
         #: covered area of every local slave cell
         self.covered_area = np.bincount(self.pairs[:, 0], weights=self.area_pairs,
                                         minlength=len(slave.cells))
         self._bases: dict[BasisKind, MortarBasis] = {}
         self._covered_mass: Optional[tuple] = None
 
-    def _raise_on_degenerate_facets(self, r: dict, xs: FloatArray, slave_cells,
+    def _raise_on_degenerate_facets(self, r: _kernels.MortarIntegrals, xs: FloatArray,
+                                    slave_cells,
                                     master_copy: SurfaceCopy) -> None:
         """A degenerate facet covers nothing: rather than let it vanish from the
         integrals, stop on every rank with the facets named."""
         comm = self.slave.layout.comm
         lines = [f"slave facet {c} (local cell index on rank {comm.rank}) with nodes "
                  f"{np.array2string(xs[slave_cells[c]], precision=17, separator=', ')}"
-                 for c in r["degenerate_slave_facets"][:5]]
+                 for c in r.degenerate_slave_facets[:5]]
         lines = [line for rank_lines in comm.allgather(lines) for line in rank_lines]
         # the master copy is the same on every rank: so is its list
         lines += [f"master facet {c} (index in the gathered master surface) with nodes "
                   f"{np.array2string(master_copy.x[master_copy.cells[c]], precision=17, separator=', ')}"
-                  for c in r["degenerate_master_facets"][:5]]
+                  for c in r.degenerate_master_facets[:5]]
         if lines:
             raise DegenerateGeometryError(
                 f"degenerate contact facets (length or height at most the zero length "

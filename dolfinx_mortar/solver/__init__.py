@@ -1,1 +1,2 @@
-"""The nonlinear problem (user form + contact), Newton, and the load-path driver."""
+"""The nonlinear problem (user form + contact), Newton, its line search and convergence
+tests, and the load-path driver."""

@@ -25,8 +25,8 @@ from dolfinx_mortar.input_checks import unused_petsc_options
 from dolfinx_mortar.io.contact_output import ContactOutput
 from dolfinx_mortar.solver.convergence import (ContactDivergenceError, EquilibriumTest,
                                                FailedAttempt, describe_failure)
-from dolfinx_mortar.solver.contact_block_pc import ContactBlockPreconditioner
-from dolfinx_mortar.solver.linear_solver import (DIRECT_OPTIONS, choose_linear_solver,
+from dolfinx_mortar.linalg.contact_block_pc import ContactBlockPreconditioner
+from dolfinx_mortar.linalg.linear_solver import (DIRECT_OPTIONS, choose_linear_solver,
                                                  iterative_options)
 from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
 from dolfinx_mortar.solver.load_stepping import LoadStepper
@@ -56,7 +56,7 @@ class LoadPathSolver:
     linear_solver
         ``"direct"`` (MUMPS), ``"iterative"`` (CG/GMRES with multigrid and an
         exact contact block) or ``"auto"`` (iterative for large 3D problems;
-        :mod:`dolfinx_mortar.solver.linear_solver`). Options under the prefix
+        :mod:`dolfinx_mortar.linalg.linear_solver`). Options under the prefix
         still override each choice.
     """
 

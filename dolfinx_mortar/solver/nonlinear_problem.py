@@ -181,7 +181,7 @@ class NonlinearContactProblem:
         (:meth:`configure_ksp`). ``ksp``, the solver that will use ``A``, has
         its preconditioner reset when the contact pairs changed ``A``'s
         pattern in a way PETSc does not notice
-        (:class:`~dolfinx_mortar.contact.sparse_products.PatternTrackingAdd`).
+        (:class:`~dolfinx_mortar.linalg.sparse_products.PatternTrackingAdd`).
         """
         clock = time.perf_counter()
         A.zeroEntries()
@@ -208,16 +208,16 @@ class NonlinearContactProblem:
 
     def near_nullspace(self) -> PETSc.NullSpace:
         """The rigid-body modes of each body of the mesh
-        (:func:`~dolfinx_mortar.solver.near_nullspace.rigid_body_modes`), made once."""
+        (:func:`~dolfinx_mortar.linalg.near_nullspace.rigid_body_modes`), made once."""
         if self._near_nullspace is None:
-            from dolfinx_mortar.solver.near_nullspace import rigid_body_modes
+            from dolfinx_mortar.linalg.near_nullspace import rigid_body_modes
             self._near_nullspace = rigid_body_modes(self.u.function_space)
         return self._near_nullspace
 
     def contact_rows(self) -> np.ndarray:
         """Global indices of this rank's rows that the contact terms stiffened
         at the last :meth:`J` (the exact block of
-        :class:`~dolfinx_mortar.solver.contact_block_pc.ContactBlockPreconditioner`)."""
+        :class:`~dolfinx_mortar.linalg.contact_block_pc.ContactBlockPreconditioner`)."""
         rows = [term.stiffened_rows for term in self.contacts]
         return np.unique(np.concatenate(rows)).astype(PETSc.IntType)
 

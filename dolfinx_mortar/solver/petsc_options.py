@@ -11,7 +11,7 @@ from typing import Any, Mapping
 
 from petsc4py import PETSc
 
-from dolfinx_mortar.solver.linear_solver import DIRECT_OPTIONS
+from dolfinx_mortar.linalg.linear_solver import DIRECT_OPTIONS
 
 #: PETSc options set unless the options database already has them
 DEFAULT_OPTIONS = {
@@ -30,7 +30,7 @@ DEFAULT_OPTIONS = {
     # before the active set settles: do not call that divergence
     "snes_divergence_tolerance": -1,
     # the linear solver: MUMPS unless the solver goes iterative
-    # (dolfinx_mortar.solver.linear_solver)
+    # (dolfinx_mortar.linalg.linear_solver)
     **DIRECT_OPTIONS,
 }
 

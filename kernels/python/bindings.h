@@ -68,4 +68,9 @@ to_numpy(const std::vector<double>& v, std::vector<py::ssize_t> shape)
 void
 bind_current_surface(py::module_& m);
 
+/// The segmentation's integrals and the current configuration's pair gaps
+/// (mortar_integrals.h, current_pair_gaps.h).
+void
+bind_segmentation(py::module_& m);
+
 } // namespace dolfinx_mortar::bindings

@@ -182,6 +182,7 @@ normal_derivatives(const FacetSurface& s,
                                 " is on no cell of the surface");
   const int nn = facet_num_nodes(s.type), gdim = s.gdim, M = nn * gdim;
   NormalDerivatives out;
+  out.gdim = gdim;
   std::unordered_map<std::int64_t, int> position;
   for (const auto& [c, i] : it->second)
     for (int j = 0; j < nn; ++j)
@@ -431,15 +432,16 @@ current_pair_gaps(const FacetSurface& slave,
                   const FacetSurface& master,
                   std::span<const std::int64_t> master_ids,
                   std::span<const std::int32_t> pairs,
-                  std::span<const double> points,
-                  std::span<const double> weights,
-                  double zero,
-                  bool opposing_normals_only,
-                  bool with_hessian,
-                  bool with_positive_part,
-                  bool axisymmetric,
-                  std::span<const double> node_weights)
+                  const PairGapOptions& options)
 {
+  const auto [points,
+              weights,
+              zero,
+              opposing_normals_only,
+              with_hessian,
+              with_positive_part,
+              axisymmetric,
+              node_weights] = options;
   slave.check();
   master.check();
   if (slave.gdim != master.gdim)
@@ -499,6 +501,10 @@ current_pair_gaps(const FacetSurface& slave,
   const std::size_t P = pairs.size() / 2;
   std::vector<PairResult> results(P);
   PairGapDerivatives out;
+  out.num_pairs = pairs.size() / 2;
+  out.functions = nf;
+  out.slave_nodes = ns;
+  out.gdim = gdim;
   std::vector<double> xs(ns * gdim), xm(nm * gdim), normals(ns * gdim);
   std::vector<double> value(nf), grad(nf * N),
     hess(with_hessian ? nf * N * N : 0),

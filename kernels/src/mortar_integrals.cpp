@@ -114,6 +114,9 @@ mortar_integrals(const FacetSurface& slave,
   }
 
   MortarIntegrals out;
+  out.gdim = slave.gdim;
+  out.slave_nodes = facet_num_nodes(slave.type);
+  out.master_nodes = facet_num_nodes(master.type);
   out.degenerate_slave_facets = degenerate_cells(slave, zero);
   out.degenerate_master_facets = degenerate_cells(master, zero);
   // a degenerate cell covers nothing and is covered by nothing

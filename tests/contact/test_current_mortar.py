@@ -2,6 +2,8 @@
 the projection and the averaged normals linearized exactly."""
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from dolfinx import fem
@@ -27,9 +29,9 @@ def test_differentiable_gaps_equal_the_kernels(kind, degree):
     state = problem.contact.evaluate()
     model = problem.gap_model
     data = state.data.source.data
-    kernel = (data["coupling"].raw_pairs[2] @ model.C)[data["pairs"]]
-    jet = model.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
-                                 with_hessian=False)["value"] @ model.C
+    kernel = (data.coupling.raw_pairs[2] @ model.C)[data.pairs]
+    jet = model.pair_derivatives(data.u_nodes, data.coupling, data.kept,
+                                 with_hessian=False).value @ model.C
     scale = problem.mesh.comm.allreduce(float(np.max(np.abs(kernel), initial=0.0)), op=MPI.MAX)
     error = problem.mesh.comm.allreduce(float(np.max(np.abs(kernel - jet), initial=0.0)),
                                         op=MPI.MAX)
@@ -67,15 +69,17 @@ def test_missing_the_normal_linearization_is_detected():
     def frozen_normals(u_nodes, coupling, gathered_pairs, with_hessian, **options):
         """Neighbour nodes held at their values: the normals lose part of their
         derivatives (the slave cell's own and the master's nodes keep theirs)."""
-        r = dict(exact(u_nodes, coupling, gathered_pairs, with_hessian, **options))
+        exact_r = exact(u_nodes, coupling, gathered_pairs, with_hessian, **options)
+        r = SimpleNamespace(**{name: getattr(exact_r, name) for name in (
+            "nodes", "value", "gradient", "hessian", "value_plus", "gradient_plus")})
         ns, nm, gdim = model.slave.cells.shape[1], 2, 2
-        nodes = r["nodes"]
+        nodes = r.nodes
         neighbour = np.zeros(nodes.shape, dtype=bool)
         for p, row in enumerate(nodes):
             count = int(np.sum(row >= 0))
             neighbour[p, ns:count - nm] = True
         columns = np.repeat(neighbour, gdim, axis=1)
-        r["gradient"] = np.where(columns[:, None, :], 0.0, r["gradient"])
+        r.gradient = np.where(columns[:, None, :], 0.0, r.gradient)
         return r
 
     model.gathered_pair_derivatives = frozen_normals
@@ -175,9 +179,9 @@ def test_current_mortar_3d_is_the_kernel_and_its_exact_derivatives(kind, scaling
     state = problem.contact.evaluate()
     model = problem.gap_model
     data = state.data.source.data
-    kernel = (data["coupling"].raw_pairs[2] @ model.C)[data["pairs"]]
-    jet = model.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
-                                 with_hessian=False)["value"] @ model.C
+    kernel = (data.coupling.raw_pairs[2] @ model.C)[data.pairs]
+    jet = model.pair_derivatives(data.u_nodes, data.coupling, data.kept,
+                                 with_hessian=False).value @ model.C
     comm = problem.mesh.comm
     scale = comm.allreduce(float(np.max(np.abs(kernel), initial=0.0)), op=MPI.MAX)
     error = comm.allreduce(float(np.max(np.abs(kernel - jet), initial=0.0)), op=MPI.MAX)

@@ -30,14 +30,14 @@ def test_jet_values_equal_the_double_kernel_and_derivatives_are_exact(kind):
     r = case.jets(case.xs, case.xm, pairs)
     # values: the same algorithm in two scalar types, equal to round-off
     scale = np.max(np.abs(gaps))
-    assert scale > 0 and np.max(np.abs(r["value"] - gaps)) <= 1e-13 * scale
+    assert scale > 0 and np.max(np.abs(r.value - gaps)) <= 1e-13 * scale
     # curved or tilted pieces: the gaps are not linear in the nodes
-    assert np.max(np.abs(r["hessian"])) > 1e-3 * np.max(np.abs(r["gradient"]))
+    assert np.max(np.abs(r.hessian)) > 1e-3 * np.max(np.abs(r.gradient))
     gdim, h = case.gdim, 1e-6
     worst_grad = worst_hess = 0.0
     for p in range(0, len(pairs), max(1, len(pairs) // 6)):
-        nodes = r["nodes"][p]
-        grad, hess = r["gradient"][p], r["hessian"][p]
+        nodes = r.nodes[p]
+        grad, hess = r.gradient[p], r.hessian[p]
         fd_grad = np.zeros_like(grad)
         fd_hess = np.zeros_like(hess)
         for v, node_id in enumerate(nodes):
@@ -47,14 +47,14 @@ def test_jet_values_equal_the_double_kernel_and_derivatives_are_exact(kind):
                 column = v * gdim + k
                 plus = case.jets(*_moved(case, node_id, k, h), pairs[p:p + 1])
                 minus = case.jets(*_moved(case, node_id, k, -h), pairs[p:p + 1])
-                fd_grad[:, column] = (plus["value"][0] - minus["value"][0]) / (2 * h)
+                fd_grad[:, column] = (plus.value[0] - minus.value[0]) / (2 * h)
                 # the perturbed pair's variables are the same nodes in the same
                 # order (alone, it is not padded)
-                width = plus["gradient"].shape[2]
-                assert np.array_equal(plus["nodes"][0], nodes[:width // gdim])
+                width = plus.gradient.shape[2]
+                assert np.array_equal(plus.nodes[0], nodes[:width // gdim])
                 assert np.all(nodes[width // gdim:] < 0)
-                fd_hess[:, :width, column] = (plus["gradient"][0]
-                                              - minus["gradient"][0]) / (2 * h)
+                fd_hess[:, :width, column] = (plus.gradient[0]
+                                              - minus.gradient[0]) / (2 * h)
         worst_grad = max(worst_grad, np.max(np.abs(fd_grad - grad)) / np.max(np.abs(grad)))
         worst_hess = max(worst_hess, np.max(np.abs(fd_hess - hess)) / np.max(np.abs(hess)))
     assert worst_grad <= 1e-8, worst_grad
@@ -66,10 +66,10 @@ def test_averaged_normal_derivatives_are_exact():
     gx, gc, gid = gathered(case.xs, case.cs)
     node = 5                                    # an interior node: six triangles around it
     r = _kernels.averaged_normal_derivatives(case.kind, gx, gc, gid, node)
-    assert np.allclose(r["value"], case.normals(case.xs)[node], rtol=0, atol=1e-15)
-    assert len(r["star"]) == 7
+    assert np.allclose(r.value, case.normals(case.xs)[node], rtol=0, atol=1e-15)
+    assert len(r.star) == 7
     h = 1e-6
-    for j, star_node in enumerate(r["star"]):
+    for j, star_node in enumerate(r.star):
         for k in range(3):
             values = []
             for sign in (1, -1):
@@ -77,8 +77,8 @@ def test_averaged_normal_derivatives_are_exact():
                 xs[star_node, k] += sign * h
                 values.append(case.normals(xs)[node])
             fd = (values[0] - values[1]) / (2 * h)
-            assert np.max(np.abs(fd - r["gradient"][:, 3 * j + k])) <= 1e-8 * np.max(
-                np.abs(r["gradient"]))
+            assert np.max(np.abs(fd - r.gradient[:, 3 * j + k])) <= 1e-8 * np.max(
+                np.abs(r.gradient))
 
 
 def test_unsupported_facets_are_named():
@@ -102,17 +102,18 @@ def test_weighted_sum_equals_the_sum_of_the_weighted_functions(kind):
     weights = np.random.default_rng(3).uniform(-1, 2, (len(pairs), case.cs.shape[1]))
     apart = case.jets(case.xs, case.xm, pairs)
     summed = case.jets(case.xs, case.xm, pairs, node_weights=weights)
-    assert np.array_equal(summed["nodes"], apart["nodes"])
+    assert np.array_equal(summed.nodes, apart.nodes)
     for key in ("value", "gradient", "hessian"):
-        expected = np.einsum("pa,pa...->p...", weights, apart[key])
-        assert summed[key].shape == (len(pairs), 1) + apart[key].shape[2:]
+        whole, parts = getattr(summed, key), getattr(apart, key)
+        expected = np.einsum("pa,pa...->p...", weights, parts)
+        assert whole.shape == (len(pairs), 1) + parts.shape[2:]
         scale = np.max(np.abs(expected))
         assert scale > 0
-        assert np.max(np.abs(summed[key][:, 0] - expected)) <= 1e-13 * scale, key
+        assert np.max(np.abs(whole[:, 0] - expected)) <= 1e-13 * scale, key
     # the gradients alone, too
     alone = case.jets(case.xs, case.xm, pairs, with_hessian=False, node_weights=weights)
-    assert np.allclose(alone["gradient"], summed["gradient"], rtol=0,
-                       atol=1e-13 * np.max(np.abs(summed["gradient"])))
+    assert np.allclose(alone.gradient, summed.gradient, rtol=0,
+                       atol=1e-13 * np.max(np.abs(summed.gradient)))
 
 
 def test_weights_of_the_wrong_shape_are_refused():
@@ -170,12 +171,12 @@ def test_affine_pairs_match_the_general_segmentation(kind):
     xs2, cs2, Ts = _quadratic_copy(kind, case.xs, case.cs)
     xm2, cm2, Tm = _quadratic_copy(kind, case.xm, case.cm)
     general = integrals(FT.P2_line if gdim == 2 else FT.P2_triangle, xs2, cs2, xm2, cm2)
-    assert len(flat["pairs"]) >= 6
-    assert np.array_equal(flat["pairs"], general["pairs"])
-    expected = {"D": np.einsum("ab,pbc,dc->pad", Ts, general["D"], Ts),
-                "M": np.einsum("ab,pbc,dc->pad", Ts, general["M"], Tm),
-                "gap": general["gap"] @ Ts.T, "area": general["area"]}
+    assert len(flat.pairs) >= 6
+    assert np.array_equal(flat.pairs, general.pairs)
+    expected = {"D": np.einsum("ab,pbc,dc->pad", Ts, general.D, Ts),
+                "M": np.einsum("ab,pbc,dc->pad", Ts, general.M, Tm),
+                "gap": general.gap @ Ts.T, "area": general.area}
     for key, value in expected.items():
         scale = np.max(np.abs(value))
         assert scale > 0
-        assert np.max(np.abs(flat[key] - value)) <= 1e-13 * scale, key
+        assert np.max(np.abs(getattr(flat, key) - value)) <= 1e-13 * scale, key

@@ -47,21 +47,21 @@ def test_kernel_positive_part_is_the_points_sum():
     state = problem.contact.evaluate()
     model = problem.gap_model
     data = state.data.source.data
-    points = data["coupling"].points
-    expected = np.zeros((len(data["coupling"].pairs), model.slave.cells.shape[1]))
-    np.add.at(expected, points["pairs"],
-              (points["weights"] * np.maximum(points["gap"], 0.0))[:, None] * points["slave_N"])
-    kernel = model.pair_derivatives(data["u_nodes"], data["coupling"], data["kept"],
-                                    with_hessian=False, with_positive_part=True)["value_plus"]
+    points = data.coupling.points
+    expected = np.zeros((len(data.coupling.pairs), model.slave.cells.shape[1]))
+    np.add.at(expected, points.pairs,
+              (points.weights * np.maximum(points.gap, 0.0))[:, None] * points.slave_N)
+    kernel = model.pair_derivatives(data.u_nodes, data.coupling, data.kept,
+                                    with_hessian=False, with_positive_part=True).value_plus
     comm = problem.mesh.comm
     scale = comm.allreduce(float(np.max(np.abs(expected), initial=0.0)), op=MPI.MAX)
-    error = comm.allreduce(float(np.max(np.abs(kernel - expected[data["kept"]]),
+    error = comm.allreduce(float(np.max(np.abs(kernel - expected[data.kept]),
                                         initial=0.0)), op=MPI.MAX)
     assert scale > 0 and error <= 1e-12 * scale
     # every pair with a penetrating point got derivatives
-    penetrating = np.zeros(len(data["coupling"].pairs), dtype=bool)
-    penetrating[points["pairs"][points["gap"] > 0]] = True
-    assert np.all(data["kept"][penetrating])
+    penetrating = np.zeros(len(data.coupling.pairs), dtype=bool)
+    penetrating[points.pairs[points.gap > 0]] = True
+    assert np.all(data.kept[penetrating])
 
 
 @pytest.mark.parametrize("kind", POINTWISE_KINDS)
@@ -72,9 +72,9 @@ def test_current_pointwise_is_the_nodal_model_where_everything_penetrates(kind):
     nodal = sheared_blocks(kind, push=0.02,
                            mesh_and_tags=(pointwise.mesh, pointwise.facet_tags))
     state = pointwise.contact.evaluate()
-    points = state.data.source.data["coupling"].points
+    points = state.data.source.data.coupling.points
     comm = pointwise.mesh.comm
-    assert comm.allreduce(int(np.sum(points["gap"] <= 0))) == 0
+    assert comm.allreduce(int(np.sum(points.gap <= 0))) == 0
     r_p, r_n = _residual(pointwise), _residual(nodal)
     scale = comm.allreduce(float(np.max(np.abs(r_n))), op=MPI.MAX)
     assert comm.allreduce(float(np.max(np.abs(r_p - r_n))), op=MPI.MAX) <= 1e-12 * scale

@@ -6,7 +6,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.sparse_products import (PatternTrackingAdd, TransposeProduct,
+from dolfinx_mortar.linalg.sparse_products import (PatternTrackingAdd, TransposeProduct,
                                                      transpose_mat_mult)
 
 N = 40

@@ -9,7 +9,7 @@ import dolfinx
 from dolfinx import fem
 import ufl
 
-from dolfinx_mortar.io.contact_partitioner import cells_near_contact, coordinate_bisection
+from dolfinx_mortar.meshes.contact_partitioner import cells_near_contact, coordinate_bisection
 from dolfinx_mortar.io.gmsh_io import grade_towards_point, model_to_mesh, read_gmsh
 
 LOWER, UPPER, MASTER, SLAVE, FAR = 1, 2, 3, 4, 5

@@ -373,7 +373,7 @@ def test_projection_along_the_given_normals_pairs_mirror_points(along_normals):
     r = kernels.mortar_integrals(line, xs, cs, normals, line, xm, cm, candidates, points,
                                  weights, project_along_normals=along_normals)
     D, M, gap = np.zeros((n, n)), np.zeros((n, n)), np.zeros(n)
-    for (s, m), Dp, Mp, gp in zip(r["pairs"], r["D"], r["M"], r["gap"]):
+    for (s, m), Dp, Mp, gp in zip(r.pairs, r.D, r.M, r.gap):
         D[np.ix_(cs[s], cs[s])] += Dp
         M[np.ix_(cs[s], cm[m])] += Mp
         gap[cs[s]] += gp

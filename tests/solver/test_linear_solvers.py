@@ -9,9 +9,9 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.solver.elastic import linear_elastic_residual
-from dolfinx_mortar.solver.linear_solver import ITERATIVE_FROM_DOFS, choose_linear_solver
-from dolfinx_mortar.solver.near_nullspace import body_labels, rigid_body_modes
+from dolfinx_mortar.small_strain.elastic import linear_elastic_residual
+from dolfinx_mortar.linalg.linear_solver import ITERATIVE_FROM_DOFS, choose_linear_solver
+from dolfinx_mortar.linalg.near_nullspace import body_labels, rigid_body_modes
 from support import load_demo
 from support.scenes import pressed_block
 

@@ -23,7 +23,7 @@ from dolfinx_mortar import (ContactDivergenceError, ContactProblem, ContactTerm,
                             LoadPathSolver, NewtonSolver, NonlinearContactProblem, RigidPlane,
                             RigidSphere, reaction_force)
 from dolfinx_mortar.io.read_series import read_xdmf_series
-from dolfinx_mortar.solver.elastic import linear_elastic_residual
+from dolfinx_mortar.small_strain.elastic import linear_elastic_residual
 from demo_support.laws import neo_hookean_residual
 from support import load_demo
 

@@ -1,4 +1,4 @@
-"""Two separately built meshes merged into one (dolfinx_mortar.io.merge_meshes) and
+"""Two separately built meshes merged into one (dolfinx_mortar.meshes.merge_meshes) and
 the contact problem between them (ContactProblem.from_two_meshes).
 
 Under ``mpirun -n 2`` the inputs are distributed by DOLFINx, and the solver
@@ -12,7 +12,7 @@ import ufl
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar.io.merge_meshes import BODY_A, BODY_B, merge_meshes
+from dolfinx_mortar.meshes.merge_meshes import BODY_A, BODY_B, merge_meshes
 from dolfinx_mortar import ContactProblem
 from support.meshes import rectangle
 

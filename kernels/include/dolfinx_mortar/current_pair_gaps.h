@@ -17,6 +17,10 @@ namespace dolfinx_mortar
 /// nodal normals).
 struct PairGapDerivatives
 {
+  std::size_t num_pairs = 0; ///< pairs
+  int functions = 0;         ///< functions per pair: ns, or 1 with node weights
+  int slave_nodes = 0;       ///< ns, nodes of a slave cell
+  int gdim = 0;              ///< geometric dimension
   int num_nodes = 0; ///< variable nodes per pair (padded to the largest)
   /// (pairs, num_nodes): global ids of the variable nodes, the slave cell's
   /// first, then the rest of the slave nodes, then the master cell's; −1
@@ -39,6 +43,7 @@ struct PairGapDerivatives
 /// its exact first and second derivatives.
 struct NormalDerivatives
 {
+  int gdim = 0;                   ///< geometric dimension
   std::vector<std::int64_t> star; ///< ids of the nodes it depends on
   std::array<double, 3> value{};  ///< unit normal (gdim used)
   std::vector<double> gradient;   ///< (gdim, star·gdim)
@@ -55,6 +60,31 @@ averaged_normal_derivatives(const FacetSurface& s,
                             std::span<const std::int64_t> ids,
                             std::int64_t node);
 
+/// How current_pair_gaps integrates and what it returns.
+struct PairGapOptions
+{
+  std::span<const double> points;  ///< the segment rule (as mortar_integrals)
+  std::span<const double> weights; ///< its weights
+  /// The zero length of the geometric decisions (the same as the values'
+  /// segmentation used)
+  double zero = 0;
+  bool opposing_normals_only = true; ///< as mortar_integrals
+  /// Also the Hessians (else `hessian` is empty and the gradients cost a
+  /// fraction: a residual needs no Hessian)
+  bool with_hessian = true;
+  /// Also c⁺_A = ∫ N_A ⟨d⟩ with its gradient (the pointwise active set), from
+  /// the same points
+  bool with_positive_part = false;
+  /// The surfaces are (r, z) meridians: every weight carries 2πr at the
+  /// slave point, and its derivatives with it
+  bool axisymmetric = false;
+  /// (pairs, ns) or empty: the outputs are then those of the one function
+  /// Σ_A w_A c_A per pair (value (pairs, 1), gradient and Hessian likewise):
+  /// a Newton matrix needs only this weighted sum of the Hessians, at a
+  /// fraction of the cost and memory of the ns apart
+  std::span<const double> node_weights;
+};
+
 /// c_A and its derivatives for every pair: integrate_pieces instantiated with
 /// a Jet over the pair's slave nodes, nodal normals and master nodes, then
 /// chained through the normals to the nodes around the slave cell.
@@ -62,19 +92,7 @@ averaged_normal_derivatives(const FacetSurface& s,
 /// @param[in] slave, master The surfaces in the current configuration
 /// @param[in] slave_ids, master_ids Global id of every node
 /// @param[in] pairs (pairs, 2): slave cell, master cell
-/// @param[in] points, weights The segment rule (as mortar_integrals)
-/// @param[in] zero The zero length of the geometric decisions (the same as
-/// the values' segmentation used)
-/// @param[in] with_hessian Also the Hessians (else `hessian` is empty and
-/// the gradients cost a fraction: a residual needs no Hessian)
-/// @param[in] with_positive_part Also c⁺_A = ∫ N_A ⟨d⟩ with its gradient
-/// (the pointwise active set), from the same points
-/// @param[in] axisymmetric The surfaces are (r, z) meridians: every weight
-/// carries 2πr at the slave point, and its derivatives with it
-/// @param[in] node_weights (pairs, ns) or empty: the outputs are then those
-/// of the one function Σ_A w_A c_A per pair (value (pairs, 1), gradient
-/// and Hessian likewise): a Newton matrix needs only this weighted sum of
-/// the Hessians, at a fraction of the cost and memory of the ns apart
+/// @param[in] options The rule and what to compute
 /// @throws std::invalid_argument for element combinations without an
 /// instantiation (3D quadratic facets), or weights of the wrong shape or
 /// with the positive part
@@ -84,13 +102,6 @@ current_pair_gaps(const FacetSurface& slave,
                   const FacetSurface& master,
                   std::span<const std::int64_t> master_ids,
                   std::span<const std::int32_t> pairs,
-                  std::span<const double> points,
-                  std::span<const double> weights,
-                  double zero,
-                  bool opposing_normals_only,
-                  bool with_hessian = true,
-                  bool with_positive_part = false,
-                  bool axisymmetric = false,
-                  std::span<const double> node_weights = {});
+                  const PairGapOptions& options);
 
 } // namespace dolfinx_mortar

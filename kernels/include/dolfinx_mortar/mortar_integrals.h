@@ -17,6 +17,9 @@ namespace dolfinx_mortar
 /// this kernel does the geometry once for all six kinds.
 struct MortarIntegrals
 {
+  int gdim = 0;                        ///< geometric dimension
+  int slave_nodes = 0;                 ///< ns, nodes of a slave cell
+  int master_nodes = 0;                ///< nm, nodes of a master cell
   std::vector<std::int32_t> pairs;     ///< (pairs, 2): slave cell, master cell
   std::vector<double> D;               ///< (pairs, ns, ns): ∫ N_A N_B
   std::vector<double> M;               ///< (pairs, ns, nm): ∫ N_A N^m_C∘χ

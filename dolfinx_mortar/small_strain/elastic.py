@@ -23,7 +23,7 @@ from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.input_checks import check_boundary_data, check_tags
 from dolfinx_mortar.kinds import KindLike
-from dolfinx_mortar.solver.axisymmetric import axisymmetric_elastic_residual, circumference
+from dolfinx_mortar.small_strain.axisymmetric import axisymmetric_elastic_residual, circumference
 from dolfinx_mortar.solver.load_path import LoadPathSolver, SolveResult, StepResult
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem, reaction_force
 
@@ -67,7 +67,7 @@ class ContactProblem:
         solver (:class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`).
     axisymmetric
         V lives on the (r, z) half-plane of a body of revolution: the bulk is
-        :func:`~dolfinx_mortar.solver.axisymmetric.axisymmetric_elastic_residual`,
+        :func:`~dolfinx_mortar.small_strain.axisymmetric.axisymmetric_elastic_residual`,
         tractions act on the swept surfaces (∫ t·v 2πr ds) and the contact
         term is axisymmetric; forces are those on the whole body.
     """
@@ -212,7 +212,7 @@ class ContactProblem:
                         shared_tags: Sequence[int] = (), **kwargs) -> "ContactProblem":
         """The contact of a slave body and an elastic master meshed separately.
 
-        Merges the meshes into one (:func:`dolfinx_mortar.io.merge_meshes.merge_meshes`:
+        Merges the meshes into one (:func:`dolfinx_mortar.meshes.merge_meshes.merge_meshes`:
         same cell type and geometry degree, any MPI distribution), builds the
         vector Lagrange space of ``degree`` on it and returns the problem.
         b's tag values enter the merged mesh as ``v + tag_offset``, except
@@ -220,7 +220,7 @@ class ContactProblem:
         values. The merged facet and cell tags (1 on a's cells, 2 on b's) are
         kept as ``problem.facet_tags`` and ``problem.cell_tags``.
         """
-        from dolfinx_mortar.io.merge_meshes import merge_meshes
+        from dolfinx_mortar.meshes.merge_meshes import merge_meshes
         mesh, facet_tags, cell_tags = merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b,
                                                    tag_offset=tag_offset,
                                                    shared_tags=shared_tags)

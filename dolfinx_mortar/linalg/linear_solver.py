@@ -8,7 +8,7 @@ preconditioned by multigrid plus an exact contact block.
     CG (the nodal active set on the initial or previous configuration: a
     symmetric Newton matrix) or GMRES (pointwise active set, current
     configuration), preconditioned by
-    :class:`~dolfinx_mortar.solver.contact_block_pc.ContactBlockPreconditioner`,
+    :class:`~dolfinx_mortar.linalg.contact_block_pc.ContactBlockPreconditioner`,
     with Eisenstat–Walker forcing terms so that early Newton iterations are not
     solved more accurately than they are worth.
 ``"auto"``

@@ -1,6 +1,6 @@
 """Two DOLFINx meshes as one mesh with two disconnected bodies (DOLFINx 0.9 to 0.11).
 
-:class:`~dolfinx_mortar.solver.elastic.ContactProblem` takes an elastic master as a
+:class:`~dolfinx_mortar.small_strain.elastic.ContactProblem` takes an elastic master as a
 second body of the *same* mesh. Bodies meshed separately (two gmsh models, two
 ``create_rectangle`` calls, two files) are merged here into one mesh: the nodes
 of body b are numbered after those of body a, the cells of both are handed to
