@@ -113,7 +113,7 @@ def run(args, orientation: str, kind: str, scaling: str, comm=MPI.COMM_WORLD) ->
                              quadratic_transform=(args.degree == 2 and d == 3))
     result = problem.solve(load_steps=1)
     state = problem.contact.evaluate()
-    p = problem.contact.nodal_pressures(state)
+    p = problem.contact.results.nodal_pressures(state)
     n = problem.slave.layout.num_owned
     on = np.zeros(problem.slave.layout.size_local, dtype=bool)
     on[problem.slave.cells] = True

@@ -252,7 +252,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
 
     def record(step) -> None:
         # the force on the obstacle is minus the resultant on the block
-        force = -contact.contact_force()
+        force = -contact.results.contact_force()
         sliding = step.load_factor > t_press * (1 + 1e-12)
         rows.append({
             "step": len(rows) + 1, "t": step.load_factor,
@@ -260,7 +260,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
             "obstacle_x": float(cylinder.center[0]), "obstacle_y": float(cylinder.center[1]),
             "slide": float(cylinder.displacement[0]),
             "normal_force": float(force[1]), "tangential_force": float(force[0]),
-            "pressure_integral": contact.normal_force(), "active_nodes": step.active_nodes,
+            "pressure_integral": contact.results.normal_force(), "active_nodes": step.active_nodes,
             "newton_iterations": step.newton_iterations,
             "terminal_iterations": step.terminal_iterations(), "residuals": step.phases})
 

@@ -55,7 +55,7 @@ def load_path(t: float) -> None:
 
 
 result = solver.solve(load_path, load_steps=4, output="results/quickstart.xdmf")
-force = contact.contact_force()                             # resultant on the block (vector)
+force = contact.results.contact_force()                         # resultant on the block (vector)
 if comm.rank == 0:
     print(f"{len(result.steps)} steps, {result.newton_iterations} Newton iterations; "
           f"contact force on the block: ({force[0]:.3e}, {force[1]:.3e})")

@@ -31,6 +31,7 @@ from dolfinx.fem import petsc as fem_petsc
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.active_set import gap_closing_force, stiffened_nodes
+from dolfinx_mortar.contact.checks import RangeChecks
 from dolfinx_mortar.contact.configuration import configuration_of
 from dolfinx_mortar.contact.newton_entry import entry_of
 from dolfinx_mortar.contact.obstacles import RigidObstacle
@@ -49,7 +50,7 @@ logger = logging.getLogger(__name__)
 MAX_RADIUS_WIDENINGS = 3
 
 
-class ContactTerm(ContactResults):
+class ContactTerm:
     """The penalty mortar contact term of one slave surface.
 
     Parameters
@@ -153,9 +154,13 @@ class ContactTerm(ContactResults):
         #: times the default search radius was widened, and whether reaching it was warned
         self._radius_widenings = 0
         self._radius_warned = False
+        #: what the term reports (pressures, forces, slip, …)
+        self.results = ContactResults(self)
+        #: its checks of the model's range
+        self.checks = RangeChecks(self)
         self.model: GapModel = self._timed_build(self.configuration.build, options)
-        self.warn_deep_initial_penetration()
-        self.warn_if_no_master_is_in_reach(self.configuration.segmentation(self.model))
+        self.checks.warn_deep_initial_penetration()
+        self.checks.warn_if_no_master_is_in_reach(self.configuration.segmentation(self.model))
 
     # -- configuration ---------------------------------------------------------------
     @property
@@ -191,13 +196,15 @@ class ContactTerm(ContactResults):
     def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:
         """Called by a load-path driver after a converged step: where the contact
         zone reached slave nodes that found no master within the search radius
-        though one lies beyond it (:meth:`contact_reached_the_search_radius`),
+        though one lies beyond it
+        (:meth:`RangeChecks.contact_reached_the_search_radius
+        <dolfinx_mortar.contact.checks.RangeChecks.contact_reached_the_search_radius>`),
         rebuild the frozen bases with four times the radius and return True (the
         step must be solved again, with a new matrix pattern). A radius the user
         gave is kept, with a warning; so is one already widened
         MAX_RADIUS_WIDENINGS times (collective)."""
         if self._radius_warned or not (
-                self.contact_reached_the_search_radius(state)):
+                self.checks.contact_reached_the_search_radius(state)):
             return False
         radius = self.model.coupling.search_radius
         widenings = self._radius_widenings
@@ -245,6 +252,11 @@ class ContactTerm(ContactResults):
         """Whether the contact Jacobian is symmetric: the nodal active set on
         frozen bases."""
         return not (self.options.law.pointwise or self.configuration.follows_u)
+
+    def evaluate(self) -> ContactState:
+        """The contact state at the present u with every dof kept (results)."""
+        self.u.x.scatter_forward()
+        return self.model.evaluate(self.u, None)
 
     # -- PETSc assembly --------------------------------------------------------------
     def mask(self, bcs: Sequence[fem.DirichletBC] = ()) -> PETSc.Vec:

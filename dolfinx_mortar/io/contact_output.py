@@ -66,10 +66,10 @@ class ContactOutput:
         """Add the step at pseudo-time ``t`` with each term's contact state."""
         total = np.zeros(self.contacts[0].slave.layout.size_local)
         for term, state, out in zip(self.contacts, states, self.surface_outputs):
-            pressures = term.nodal_pressures(state)
+            pressures = term.results.nodal_pressures(state)
             total += pressures
             out.write({"p_hat": pressures[term.slave.cells],
-                       "p_star": term.mortar_traction(state)}, t)
+                       "p_star": term.results.mortar_traction(state)}, t)
         u1 = fem.Function(self.V1, name="displacement")
         u1.interpolate(self.u)
         p = fem.Function(self.Q, name="contact_pressure")

@@ -182,24 +182,24 @@ class ContactProblem:
 
     # -- results ---------------------------------------------------------------------
     def nodal_gaps(self):
-        return self.contact.nodal_gaps()
+        return self.contact.results.nodal_gaps()
 
     def nodal_pressures(self, state=None):
-        return self.contact.nodal_pressures(state)
+        return self.contact.results.nodal_pressures(state)
 
     def surface_pressure(self, state=None, gather: bool = False):
         """The contact pressure at the slave nodes with their coordinates
         (:meth:`~dolfinx_mortar.contact.results.ContactResults.surface_pressure`)."""
-        return self.contact.surface_pressure(state, gather)
+        return self.contact.results.surface_pressure(state, gather)
 
     def mortar_traction(self, state=None):
-        return self.contact.mortar_traction(state)
+        return self.contact.results.mortar_traction(state)
 
     def normal_force(self) -> float:
-        return self.contact.normal_force()
+        return self.contact.results.normal_force()
 
     def contact_force(self):
-        return self.contact.contact_force()
+        return self.contact.results.contact_force()
 
     def reaction_force(self, tag: int):
         """The force of the supports on facets ``tag`` on the body

@@ -273,9 +273,9 @@ class LoadPathSolver:
                         continue
                     if path is not None:
                         path.converged(target, u.x.petsc_vec)
-                    deepest = [max(worst, term.penetration(state), key=lambda d: d[0])
+                    deepest = [max(worst, term.results.penetration(state), key=lambda d: d[0])
                                for worst, term, state in zip(deepest, self.contacts, states)]
-                    active = sum(t.active_nodes(s) for t, s in zip(self.contacts, states))
+                    active = sum(t.results.active_nodes(s) for t, s in zip(self.contacts, states))
                     step = StepResult(target, outcome.iterations, outcome.residuals,
                                       time.perf_counter() - clock, active, outcome.phases,
                                       outcome.reference, outcome.linear_iterations)
@@ -285,13 +285,13 @@ class LoadPathSolver:
                     if bar is not None:
                         bar.update(stepper.fraction_of_steps - before)
                     for term, state in zip(self.contacts, states):
-                        term.warn_if_slipped_too_far(state)
+                        term.checks.warn_if_slipped_too_far(state)
                     if writer is not None:
                         writer.write(target, states)
                     if on_step is not None:
                         on_step(step)
                 for term, worst in zip(self.contacts, deepest):
-                    term.warn_if_the_penalty_is_low(worst)
+                    term.checks.warn_if_the_penalty_is_low(worst)
             finally:
                 if bar is not None:
                     bar.close()
@@ -353,7 +353,7 @@ class LoadPathSolver:
         # u holds the last iterate; the frozen phase's states are gone with its model
         states = [term.state if term.state is not None else term.evaluate()
                   for term in self.contacts]
-        if sum(term.active_nodes(state) for term, state in zip(self.contacts, states)) > 0:
+        if sum(term.results.active_nodes(state) for term, state in zip(self.contacts, states)) > 0:
             return ""
         return ("; no slave node was in contact at the last iterate: if only the contact "
                 "holds the body, the load pulls it away from the master or obstacle, or "

@@ -413,6 +413,100 @@ inner_for(int N, int NG)
   }
   return nullptr;
 }
+/// One pair's gaps and their derivatives with respect to its own variable
+/// nodes (current_pair_gaps).
+struct PairResult
+{
+  std::vector<std::int64_t> nodes;
+  std::vector<double> value, gradient, hessian, value_plus, gradient_plus;
+};
+
+/// The pairs' results into @p out, every pair padded to the largest variable
+/// count (nodes −1, derivatives 0); @p out's shape fields are set.
+void
+pad_pairs(const std::vector<PairResult>& results,
+          bool with_hessian,
+          bool with_positive_part,
+          PairGapDerivatives& out)
+{
+  const std::size_t P = results.size();
+  const int nf = out.functions, ns = out.slave_nodes, gdim = out.gdim;
+  std::size_t width = 0;
+  for (const PairResult& r : results)
+    width = std::max(width, r.nodes.size());
+  out.num_nodes = static_cast<int>(width);
+  const std::size_t Kw = width * gdim;
+  out.nodes.assign(P * width, -1);
+  out.value.assign(P * nf, 0.0);
+  out.gradient.assign(P * nf * Kw, 0.0);
+  out.hessian.assign(with_hessian ? P * nf * Kw * Kw : 0, 0.0);
+  out.value_plus.assign(with_positive_part ? P * ns : 0, 0.0);
+  out.gradient_plus.assign(with_positive_part ? P * ns * Kw : 0, 0.0);
+  for (std::size_t p = 0; p < P; ++p)
+  {
+    const PairResult& r = results[p];
+    const std::size_t K = r.nodes.size() * gdim;
+    std::copy(r.nodes.begin(), r.nodes.end(), out.nodes.begin() + p * width);
+    std::copy(r.value.begin(), r.value.end(), out.value.begin() + p * nf);
+    std::copy(r.value_plus.begin(),
+              r.value_plus.end(),
+              out.value_plus.begin() + p * ns);
+    if (with_positive_part)
+      for (int a = 0; a < ns; ++a)
+        std::copy_n(r.gradient_plus.begin() + a * K,
+                    K,
+                    out.gradient_plus.begin() + (p * ns + a) * Kw);
+    for (int a = 0; a < nf; ++a)
+    {
+      std::copy_n(r.gradient.begin() + a * K,
+                  K,
+                  out.gradient.begin() + (p * nf + a) * Kw);
+      if (!with_hessian)
+        continue;
+      for (std::size_t i = 0; i < K; ++i)
+        std::copy_n(r.hessian.begin() + (a * K + i) * K,
+                    K,
+                    out.hessian.begin() + ((p * nf + a) * Kw + i) * Kw);
+    }
+  }
+}
+
+/// @throws std::invalid_argument naming what of current_pair_gaps' input is
+/// inconsistent
+void
+check_input(const FacetSurface& slave,
+            std::span<const std::int64_t> slave_ids,
+            const FacetSurface& master,
+            std::span<const std::int64_t> master_ids,
+            std::span<const std::int32_t> pairs,
+            const PairGapOptions& options)
+{
+  slave.check();
+  master.check();
+  if (slave.gdim != master.gdim)
+    throw std::invalid_argument("slave and master surfaces differ in gdim");
+  const int gdim = slave.gdim;
+  if (options.axisymmetric and gdim != 2)
+    throw std::invalid_argument(
+      "axisymmetric surfaces are (r, z) lines: gdim must be 2");
+  if (slave_ids.size() != slave.x.size() / gdim or
+      master_ids.size() != master.x.size() / gdim)
+    throw std::invalid_argument("one id per surface node expected");
+  if (pairs.size() % 2 != 0)
+    throw std::invalid_argument("pairs must have shape (pairs, 2)");
+  if (options.points.size() != options.weights.size() * (gdim - 1))
+    throw std::invalid_argument("quadrature points must have shape (points, " +
+                                std::to_string(gdim - 1) + ")");
+  const int ns = facet_num_nodes(slave.type);
+  const bool weighted = !options.node_weights.empty();
+  if (weighted and options.node_weights.size() != pairs.size() / 2 * ns)
+    throw std::invalid_argument("node_weights must have shape (pairs, " +
+                                std::to_string(ns) + ")");
+  if (weighted and options.with_positive_part)
+    throw std::invalid_argument(
+      "node_weights combine c_A only, not the positive part's c⁺_A");
+}
+
 } // namespace
 
 NormalDerivatives
@@ -442,31 +536,11 @@ current_pair_gaps(const FacetSurface& slave,
               with_positive_part,
               axisymmetric,
               node_weights] = options;
-  slave.check();
-  master.check();
-  if (slave.gdim != master.gdim)
-    throw std::invalid_argument("slave and master surfaces differ in gdim");
+  check_input(slave, slave_ids, master, master_ids, pairs, options);
   const int gdim = slave.gdim;
-  if (axisymmetric and gdim != 2)
-    throw std::invalid_argument(
-      "axisymmetric surfaces are (r, z) lines: gdim must be 2");
-  if (slave_ids.size() != slave.x.size() / gdim or
-      master_ids.size() != master.x.size() / gdim)
-    throw std::invalid_argument("one id per surface node expected");
-  if (pairs.size() % 2 != 0)
-    throw std::invalid_argument("pairs must have shape (pairs, 2)");
-  if (points.size() != weights.size() * (gdim - 1))
-    throw std::invalid_argument("quadrature points must have shape (points, " +
-                                std::to_string(gdim - 1) + ")");
   const int ns = facet_num_nodes(slave.type), nm = facet_num_nodes(master.type);
   const int N = (2 * ns + nm) * gdim;
   const bool weighted = !node_weights.empty();
-  if (weighted and node_weights.size() != pairs.size() / 2 * ns)
-    throw std::invalid_argument("node_weights must have shape (pairs, " +
-                                std::to_string(ns) + ")");
-  if (weighted and with_positive_part)
-    throw std::invalid_argument(
-      "node_weights combine c_A only, not the positive part's c⁺_A");
   // functions per pair: the ns c_A, or their one weighted sum
   const int nf = weighted ? 1 : ns;
   const int NG = (ns + nm) * gdim;
@@ -493,11 +567,6 @@ current_pair_gaps(const FacetSurface& slave,
     return it->second;
   };
 
-  struct PairResult
-  {
-    std::vector<std::int64_t> nodes;
-    std::vector<double> value, gradient, hessian, value_plus, gradient_plus;
-  };
   const std::size_t P = pairs.size() / 2;
   std::vector<PairResult> results(P);
   PairGapDerivatives out;
@@ -649,45 +718,7 @@ current_pair_gaps(const FacetSurface& slave,
     }
   }
 
-  // pad every pair to the largest variable count
-  std::size_t width = 0;
-  for (const PairResult& r : results)
-    width = std::max(width, r.nodes.size());
-  out.num_nodes = static_cast<int>(width);
-  const std::size_t Kw = width * gdim;
-  out.nodes.assign(P * width, -1);
-  out.value.assign(P * nf, 0.0);
-  out.gradient.assign(P * nf * Kw, 0.0);
-  out.hessian.assign(with_hessian ? P * nf * Kw * Kw : 0, 0.0);
-  out.value_plus.assign(with_positive_part ? P * ns : 0, 0.0);
-  out.gradient_plus.assign(with_positive_part ? P * ns * Kw : 0, 0.0);
-  for (std::size_t p = 0; p < P; ++p)
-  {
-    const PairResult& r = results[p];
-    const std::size_t K = r.nodes.size() * gdim;
-    std::copy(r.nodes.begin(), r.nodes.end(), out.nodes.begin() + p * width);
-    std::copy(r.value.begin(), r.value.end(), out.value.begin() + p * nf);
-    std::copy(r.value_plus.begin(),
-              r.value_plus.end(),
-              out.value_plus.begin() + p * ns);
-    if (with_positive_part)
-      for (int a = 0; a < ns; ++a)
-        std::copy_n(r.gradient_plus.begin() + a * K,
-                    K,
-                    out.gradient_plus.begin() + (p * ns + a) * Kw);
-    for (int a = 0; a < nf; ++a)
-    {
-      std::copy_n(r.gradient.begin() + a * K,
-                  K,
-                  out.gradient.begin() + (p * nf + a) * Kw);
-      if (!with_hessian)
-        continue;
-      for (std::size_t i = 0; i < K; ++i)
-        std::copy_n(r.hessian.begin() + (a * K + i) * K,
-                    K,
-                    out.hessian.begin() + ((p * nf + a) * Kw + i) * Kw);
-    }
-  }
+  pad_pairs(results, with_hessian, with_positive_part, out);
   return out;
 }
 

@@ -233,15 +233,15 @@ def test_separated_bodies_feel_no_contact_force():
     contact = ContactTerm(u, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, kind="LcLS*",
                           penalty=1e3 / fine, axisymmetric=True)
     n = contact.slave.layout.num_owned
-    gaps = contact.nodal_gaps()
+    gaps = contact.results.nodal_gaps()
     on = np.zeros(contact.slave.layout.size_local, dtype=bool)
     on[contact.slave.cells] = True
     assert domain.comm.allreduce(float(np.max(gaps[:n][on[:n]], initial=-np.inf)),
                                  op=MPI.MAX) < 0
     # against the force a penetration as deep as the gap would give on the whole face
     scale = 1e3 / fine * 1e-4 * np.pi
-    assert np.max(np.abs(contact.contact_force())) <= 1e-12 * scale
-    pressures = contact.nodal_pressures()[:n]
+    assert np.max(np.abs(contact.results.contact_force())) <= 1e-12 * scale
+    pressures = contact.results.nodal_pressures()[:n]
     assert domain.comm.allreduce(float(np.max(np.abs(pressures), initial=0.0)),
                                  op=MPI.MAX) <= 1e-12 * 1e3 / fine * 1e-4
 
@@ -264,7 +264,7 @@ def test_pointwise_gaps_on_cut_cells_carry_the_circumference(kind):
         return np.maximum(0.0, 2.02 - np.sqrt(x[0] ** 2 + (x[1] + 2.0) ** 2))
     expected = penalty * fine.nodal_values(depth)
     n = contact.slave.layout.num_owned
-    error = np.max(np.abs(contact.nodal_pressures()[:n] - expected[:n]), initial=0.0)
+    error = np.max(np.abs(contact.results.nodal_pressures()[:n] - expected[:n]), initial=0.0)
     scale = np.max(np.abs(expected))
     # the Gauss rule of the full cells (degree 4) meets the sphere within 3e-5
     assert contact.mesh.comm.allreduce(float(error), op=MPI.MAX) < 1e-4 * max(

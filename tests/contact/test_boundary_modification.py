@@ -94,7 +94,7 @@ def test_two_touching_cylinders_see_their_true_separation_by_default(axisymmetri
         contact = ContactTerm(u, tags, SLAVE, master_tag=MASTER, kind="LcLS*", penalty=1e3,
                               axisymmetric=axisymmetric, **options)
         n = contact.slave.layout.num_owned
-        gap = contact.nodal_gaps()[:n]
+        gap = contact.results.nodal_gaps()[:n]
         covered = contact.model.covered[:n]
         r = contact.slave.x[:n, 0]
         last = (float(np.max(r[covered], initial=-np.inf)), 0.0)

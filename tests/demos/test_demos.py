@@ -73,7 +73,7 @@ def test_quickstart_runs_and_balances(tmp_path, monkeypatch):
     workdir = MPI.COMM_WORLD.bcast(str(tmp_path), root=0)
     monkeypatch.chdir(workdir)
     scene = runpy.run_path(str(DEMOS / "quickstart.py"))
-    force = scene["contact"].contact_force()
+    force = scene["contact"].results.contact_force()
     # frictionless on a symmetric scene: a horizontal force only from the
     # mesh's asymmetry (1.0e-7 of the vertical one with gmsh 4.13's mesh)
     assert force[1] > 0 and abs(force[0]) < 1e-6 * force[1]

@@ -92,7 +92,7 @@ def test_neo_hookean_user_form_has_the_exact_jacobian(kind, configuration):
     # of a nonlinear form is only differentiated there)
     fem.petsc.set_bc(u.x.petsc_vec, bcs)
     u.x.scatter_forward()
-    p = contact.nodal_pressures()
+    p = contact.results.nodal_pressures()
     n = contact.slave.layout.num_owned
     assert domain.comm.allreduce(int(np.sum(p[:n] > 0))) > 0   # partly in contact
     assert domain.comm.allreduce(int(np.sum(p[:n] == 0))) > 0
@@ -135,7 +135,7 @@ def test_dolfinx_newton_solver_drives_the_contact_problem(kind, driver):
         assert problem.solve() is u
         assert problem.solver.getConvergedReason() > 0
     p_exact = uniform_pressure(delta, penalty)
-    p = contact.nodal_pressures()
+    p = contact.results.nodal_pressures()
     on = np.zeros(len(p), dtype=bool)
     on[contact.slave.cells] = True
     on[contact.slave.layout.num_owned:] = False
@@ -143,9 +143,9 @@ def test_dolfinx_newton_solver_drives_the_contact_problem(kind, driver):
                                   op=MPI.MAX)
     assert error < 1e-8 * p_exact
     # the resultant on the slave pushes up; the top's support pulls down as much
-    force = contact.contact_force()
+    force = contact.results.contact_force()
     assert force[1] == pytest.approx(p_exact, rel=1e-8) and abs(force[0]) < 1e-10 * p_exact
-    assert contact.normal_force() == pytest.approx(p_exact, rel=1e-8)
+    assert contact.results.normal_force() == pytest.approx(p_exact, rel=1e-8)
     assert reaction_force(problem, tags, TOP)[1] == pytest.approx(-p_exact, rel=1e-8)
 
 
@@ -170,7 +170,7 @@ def test_load_path_moves_the_obstacle_and_takes_petsc_options(tmp_path):
     output = Path(domain.comm.bcast(str(tmp_path / "path.xdmf"), root=0))  # one file for all ranks
     result = solver.solve(lambda t: plane.move_to([0.0, 0.01 * t]), load_steps=3,
                           output=output,
-                          on_step=lambda step: seen.append(contact.contact_force()[1]))
+                          on_step=lambda step: seen.append(contact.results.contact_force()[1]))
     assert [s.load_factor for s in result.steps] == pytest.approx([1 / 3, 2 / 3, 1.0])
     p = [uniform_pressure(0.01 * t, 1e3) for t in (1 / 3, 2 / 3, 1.0)]
     assert seen == pytest.approx(p, rel=1e-8)
@@ -210,7 +210,7 @@ def test_initial_configuration_warns_past_an_element_of_slip(configuration):
         problem.solve(load_steps=3)
     slipped = [w for w in caught if "slipped" in str(w.message)]
     assert len(slipped) == (1 if configuration == "initial" else 0)
-    assert problem.contact.slip() > (1.0 if configuration == "initial" else -1.0)
+    assert problem.contact.results.slip() > (1.0 if configuration == "initial" else -1.0)
 
 
 def test_contact_term_refuses_bad_input():
@@ -245,7 +245,7 @@ def test_linear_predictor_starts_a_linear_path_at_its_solution(predictor):
     forces = []
     result = LoadPathSolver(problem).solve(
         lambda t: plane.move_to([0.0, 0.01 * (1 + t)]), load_steps=5, predictor=predictor,
-        on_step=lambda step: forces.append(contact.contact_force()[1]))
+        on_step=lambda step: forces.append(contact.results.contact_force()[1]))
     assert forces == pytest.approx([uniform_pressure(0.01 * (1 + t), 1e3)
                                     for t in (0.2, 0.4, 0.6, 0.8, 1.0)], rel=1e-8)
     iterations = [step.newton_iterations for step in result.steps]

@@ -82,7 +82,7 @@ def test_two_materials_in_one_form_reproduce_the_piecewise_linear_solution(kind)
 
     LoadPathSolver(problem).solve(press, load_steps=1)
 
-    pressures = contact.nodal_pressures()
+    pressures = contact.results.nodal_pressures()
     n = contact.slave.layout.num_owned
     on = np.zeros(contact.slave.layout.size_local, dtype=bool)
     on[contact.slave.cells] = True
@@ -102,5 +102,5 @@ def test_two_materials_in_one_form_reproduce_the_piecewise_linear_solution(kind)
 
     # the load goes through: the upper block pushes the lower one (the slave)
     # down by p over the unit width, and the bottom support pushes back
-    assert contact.contact_force()[1] == pytest.approx(-p, rel=1e-8)
+    assert contact.results.contact_force()[1] == pytest.approx(-p, rel=1e-8)
     assert reaction_force(problem, facet_tags, demo.BOTTOM)[1] == pytest.approx(p, rel=1e-8)

@@ -1,0 +1,185 @@
+"""The contact term's checks of its own range: a configuration that has left
+what the model can represent is warned about (or, for the search radius,
+acted on) instead of solved silently.
+
+Each check is a method of :class:`RangeChecks`, which a term holds as
+``term.checks``: the term where it is made, a load-path driver after each
+converged step and at the end of a solve.
+"""
+from __future__ import annotations
+
+import warnings
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.kinds import DUAL_KINDS
+from dolfinx_mortar.mortar.coupling import MortarCoupling
+
+FloatArray = npt.NDArray[np.float64]
+
+#: an initial penetration deeper than this many slave element lengths is warned about
+DEEP_PENETRATION = 0.5
+#: a penetration at convergence deeper than this many slave element lengths is
+#: warned about: the penalty is low for the mesh (ε 1000× too low gave 0.055)
+PENALTY_PENETRATION = 0.01
+#: the penetration, in element lengths, that the suggested penalty aims at
+SUGGESTED_PENETRATION = 1e-3
+#: basis_configuration="initial" is warned about past this many element lengths of slip
+SLIP_LIMIT = 1.0
+
+
+class RangeChecks:
+    """The checks of one contact term (``term.checks``); each warns once."""
+
+    def __init__(self, term):
+        self.term = term
+        self._slip_warned = False
+        #: (coupling, slave nodes a four times wider search pairs) of the last check
+        self._beyond_radius: Optional[tuple] = None
+
+    def warn_deep_initial_penetration(self) -> None:
+        """Warn when the configuration penetrates by more than DEEP_PENETRATION
+        slave element lengths (a rigid plane placed 0.2 deep into a 0.5-high
+        block solved without a word)."""
+        state = self.term.evaluate()
+        slave = self.term.slave
+        # nodes of this rank's cells (on_cells also counts other ranks' cells)
+        on_local_cell = np.zeros(slave.layout.size_local, dtype=bool)
+        on_local_cell[slave.cells] = True
+        covered = state.covered & on_local_cell
+        ratio, gap, x = self.term.results.deepest(np.where(covered, state.gaps, -np.inf))
+        if ratio > DEEP_PENETRATION:
+            hint = ""
+            options = self.term.options
+            if (self.term.master is not None and options.kind in DUAL_KINDS
+                    and not options.boundary_modification):
+                # the dual functions are negative near the far node of a facet:
+                # a facet covered only there by the master "sees" a penetration
+                hint = ("; or, with a dual kind against an elastic master, a slave facet only "
+                        "partly covered by the master (at the edge of the search radius or "
+                        "of the master) shows a false penetration: pass "
+                        "boundary_modification=True")
+            warnings.warn(f"the initial configuration penetrates by {gap:.3g} ({ratio:.3g} "
+                          f"slave element lengths) at the slave node {x}: check the "
+                          "obstacle's position and normal, or the tags of slave and master"
+                          + hint, RuntimeWarning, stacklevel=3)
+
+    def warn_if_the_penalty_is_low(self, deepest: tuple[float, float, list]) -> None:
+        """Warn when the deepest :meth:`penetration` of a solve exceeds
+        PENALTY_PENETRATION slave element lengths, naming the penalty and one
+        that would bring it to SUGGESTED_PENETRATION.
+
+        The penetration falls about as 1/ε, exactly so under a prescribed
+        force. A penalty 1000 times too low penetrated by 5.5% of an element
+        without a word.
+        """
+        ratio, depth, x = deepest
+        if ratio <= PENALTY_PENETRATION:
+            return
+        penalty = self.term.options.penalty
+        suggested = penalty * ratio / SUGGESTED_PENETRATION
+        warnings.warn(f"at convergence the slave surface penetrates by {depth:.3g} "
+                      f"({ratio:.2g} slave element lengths) at the node {x}: the penalty "
+                      f"{penalty:.3g} is low for this mesh; about {suggested:.3g} would "
+                      f"bring the penetration to {SUGGESTED_PENETRATION:g} element lengths "
+                      "(it falls about as 1/penalty)", RuntimeWarning, stacklevel=3)
+
+    def warn_if_slipped_too_far(self, state: Optional[ContactState] = None) -> None:
+        """With ``basis_configuration="initial"``: warn (once) past SLIP_LIMIT
+        element lengths of slip (:meth:`slip`). A press-then-slide run gave a
+        normal force growing 3× and a frictionless tangential force of 33% of
+        it without a word. Against a rigid obstacle the gap is exact in u
+        whatever the slip (no segmentation is frozen): no warning."""
+        if (not self.term.configuration.pairs_found_once or self.term.obstacle is not None
+                or self._slip_warned):
+            return
+        s = self.term.results.slip(state)
+        if s > SLIP_LIMIT:
+            self._slip_warned = True
+            warnings.warn(f"contact surfaces slipped {s:.3g} element lengths past the "
+                          "configuration of the bases (basis_configuration='initial', valid "
+                          "to about one element of slip): the forces are no longer reliable; "
+                          "use basis_configuration='previous' or 'current'",
+                          RuntimeWarning, stacklevel=3)
+
+    def warn_if_no_master_is_in_reach(self, coupling: Optional[MortarCoupling] = None) -> None:
+        """Against an elastic master, warn when no slave facet finds a master
+        facet within the search radius, saying whether the master faces away.
+
+        Both ended in "maximum Newton iterations" or "stalled" with no word on
+        the cause: a master surface whose outward normal points the same way
+        as the slave's (the far side of the other body, or tags swapped) is
+        never paired, since only opposing facets are; a master beyond the
+        search radius is not paired either, and in the initial configuration
+        it never will be. ``coupling``: a segmentation of this configuration
+        already made (None: one is made here).
+        """
+        if self.term.master is None:
+            return
+        comm = self.term.mesh.comm
+        radius = self.term.options.search_radius
+        if coupling is None:        # the current surface: one segmentation for this check
+            coupling = MortarCoupling(self.term.slave, self.term.master, search_radius=radius)
+        if comm.allreduce(len(coupling.pairs)) > 0:
+            return
+        radius = coupling.search_radius
+        either_way = MortarCoupling(self.term.slave, self.term.master, search_radius=radius,
+                                    opposing_normals_only=False)
+        if comm.allreduce(len(either_way.pairs)) > 0:
+            warnings.warn(f"the master surface faces away from the slave: within the search "
+                          f"radius {radius:.3g} the slave facets find only master facets "
+                          "whose outward normals point the same way as theirs, and those "
+                          "are never paired. The master must be the surface of the other "
+                          "body that faces the slave: check the master_tag, and that "
+                          "slave and master tags are not swapped", RuntimeWarning,
+                          stacklevel=3)
+            return
+        never = (" With basis_configuration='initial' the pairs are found only here, so "
+                 "it never will." if self.term.configuration.pairs_found_once else "")
+        warnings.warn(f"no slave facet finds a master facet within the search radius "
+                      f"{radius:.3g} along its normal: the contact cannot act until the "
+                      f"surfaces come within it.{never} Check the slave and master tags and "
+                      "the bodies' positions, or pass a larger search_radius", RuntimeWarning,
+                      stacklevel=3)
+
+    def contact_reached_the_search_radius(self, state: Optional[ContactState] = None) -> bool:
+        """With bases frozen against an elastic master: whether the contact zone
+        reaches slave nodes that found no master within the search radius, though
+        a master lies within four times it (collective).
+
+        The pairs are found once per frozen configuration, along the normal and
+        within the search radius (the largest slave facet by default); where the
+        surfaces were further apart then, the pressure is cut off, with a peak
+        at the last paired node. Two equal cylinders with a = R/10 on a mesh
+        graded to h = a/40 lost the outer fifth of the contact zone that way and
+        had the pressure 51% off.
+        """
+        if self.term.master is None or self.term.configuration.follows_u:
+            return False
+        model, slave = self.term.model, self.term.slave
+        comm = self.term.mesh.comm
+        state = state or self.term.evaluate()
+        covered = state.covered
+        cells = slave.cells
+        # p is ε⟨d̄⟩: exactly 0 off the active set
+        active = self.term.results.nodal_pressures(state) > 0
+        at_edge = (active[cells].any(axis=1) & ~covered[cells].all(axis=1)
+                   if len(cells) else np.zeros(0, dtype=bool))
+        if not comm.allreduce(bool(at_edge.any()), op=MPI.LOR):
+            return False
+        coupling = model.coupling
+        cached = self._beyond_radius
+        if cached is None or cached[0] is not coupling:
+            # one wider segmentation per frozen configuration, not one per step
+            wider = MortarCoupling(coupling.slave, coupling.master,
+                                   search_radius=4 * coupling.search_radius)
+            cached = (coupling, slave.layout.on_cells(slave.cells[wider.pairs[:, 0]]))
+            self._beyond_radius = cached
+        reached = cached[1] & ~covered
+        near_edge = np.zeros(slave.layout.size_local, dtype=bool)
+        near_edge[cells[at_edge].ravel()] = True
+        return bool(comm.allreduce(bool(np.any(reached & near_edge)), op=MPI.LOR))
