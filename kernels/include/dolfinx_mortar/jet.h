@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: MIT
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -230,6 +231,19 @@ widen(const Jet<N, Order>& x, int split, int shift)
     }
   }
   return y;
+}
+
+/// Value, gradient and full Hessian of a Jet, into flat arrays (@p g: N,
+/// @p H: N × N row-major).
+template<int N>
+void
+unpack(const Jet<N>& x, double& v, double* g, double* H)
+{
+  v = x.v;
+  std::copy(x.g.begin(), x.g.end(), g);
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j)
+      H[i * N + j] = x.hessian(i, j);
 }
 
 /// The value of a scalar: itself for double, the value part of a Jet. Every
