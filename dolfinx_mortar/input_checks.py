@@ -185,3 +185,24 @@ def check_contact_tags(mesh, facet_tags, slave_tag: int, master_tag: Optional[in
         if mesh.comm.allreduce(len(np.intersect1d(a, b))) > 0:
             raise ValueError(f"slave tag {slave_tag} and master tag {master_tag} "
                              "overlap: a facet cannot be both")
+
+
+def check_contact_arguments(u, master_tag: Optional[int], obstacle,
+                            axisymmetric: bool) -> None:
+    """The displacement, the master or obstacle and the mesh's dimension given to
+    a contact term."""
+    if not isinstance(u, dolfinx.fem.Function):
+        raise TypeError(f"u must be a dolfinx.fem.Function (the displacement), got "
+                        f"{type(u).__name__}")
+    V = u.function_space
+    gdim = V.mesh.geometry.dim
+    if V.dofmap.index_map_bs != gdim:
+        raise ValueError(f"u must be a vector Function with {gdim} components per node")
+    if (master_tag is None) == (obstacle is None):
+        raise ValueError("give exactly one of master_tag (elastic master) and obstacle "
+                         "(rigid analytic obstacle)")
+    if obstacle is not None and obstacle.gdim != gdim:
+        raise ValueError(f"a {obstacle.gdim}D obstacle in a {gdim}D mesh: the option "
+                         "does not fit the mesh's dimension")
+    if axisymmetric and gdim != 2:
+        raise ValueError(f"axisymmetric contact needs a 2D (r, z) mesh, got a {gdim}D one")

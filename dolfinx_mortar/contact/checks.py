@@ -8,6 +8,7 @@ converged step and at the end of a solve.
 """
 from __future__ import annotations
 
+import logging
 import warnings
 from typing import Optional
 
@@ -30,6 +31,10 @@ PENALTY_PENETRATION = 0.01
 SUGGESTED_PENETRATION = 1e-3
 #: basis_configuration="initial" is warned about past this many element lengths of slip
 SLIP_LIMIT = 1.0
+#: how many times a default search radius is widened (×4 each) before the
+#: contact zone's reaching it is only warned about
+MAX_RADIUS_WIDENINGS = 3
+logger = logging.getLogger(__name__)
 
 
 class RangeChecks:
@@ -40,6 +45,9 @@ class RangeChecks:
         self._slip_warned = False
         #: (coupling, slave nodes a four times wider search pairs) of the last check
         self._beyond_radius: Optional[tuple] = None
+        #: times the default search radius was widened, and whether reaching it was warned
+        self._radius_widenings = 0
+        self._radius_warned = False
 
     def warn_deep_initial_penetration(self) -> None:
         """Warn when the configuration penetrates by more than DEEP_PENETRATION
@@ -183,3 +191,34 @@ class RangeChecks:
         near_edge = np.zeros(slave.layout.size_local, dtype=bool)
         near_edge[cells[at_edge].ravel()] = True
         return bool(comm.allreduce(bool(np.any(reached & near_edge)), op=MPI.LOR))
+
+    def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:
+        """Called by a load-path driver after a converged step: where the contact
+        zone reached slave nodes that found no master within the search radius
+        though one lies beyond it
+        (:meth:`contact_reached_the_search_radius`),
+        rebuild the frozen bases with four times the radius and return True (the
+        step must be solved again, with a new matrix pattern). A radius the user
+        gave is kept, with a warning; so is one already widened
+        MAX_RADIUS_WIDENINGS times (collective)."""
+        if self._radius_warned or not self.contact_reached_the_search_radius(state):
+            return False
+        term = self.term
+        radius = term.model.coupling.search_radius
+        widenings = self._radius_widenings
+        if term.options.search_radius is None or widenings > 0:
+            if widenings < MAX_RADIUS_WIDENINGS:
+                self._radius_widenings = widenings + 1
+                term.rebuild(4 * radius)
+                if term.mesh.comm.rank == 0:
+                    logger.info("the contact zone reached slave nodes with no master within "
+                                "the search radius %.3g: bases rebuilt with %.3g, step "
+                                "solved again", radius, 4 * radius)
+                return True
+        self._radius_warned = True
+        warnings.warn(f"the contact zone reached slave nodes that found no master within "
+                      f"the search radius {radius:.3g}, though a master lies beyond it: the "
+                      f"pressure is cut off there. Pass a larger search_radius (e.g. "
+                      f"{4 * radius:.3g}) or basis_configuration='previous'",
+                      RuntimeWarning, stacklevel=3)
+        return False

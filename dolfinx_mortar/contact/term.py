@@ -17,9 +17,7 @@ does exactly this around the user's residual form.
 """
 from __future__ import annotations
 
-import logging
 import time
-import warnings
 from contextlib import contextmanager
 from dataclasses import replace
 from typing import Iterator, Optional, Sequence
@@ -40,14 +38,11 @@ from dolfinx_mortar.contact.results import ContactResults
 from dolfinx_mortar.contact.state import ContactState, GapModel
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.kinds import KindLike
-from dolfinx_mortar.input_checks import check_cells, check_contact_tags
+from dolfinx_mortar.input_checks import (check_cells, check_contact_arguments,
+                                         check_contact_tags)
 from dolfinx_mortar.surfaces.facet_surface import facet_surface
 
 FloatArray = npt.NDArray[np.float64]
-logger = logging.getLogger(__name__)
-#: how many times a default search radius is widened (×4 each) before the
-#: contact zone's reaching it is only warned about
-MAX_RADIUS_WIDENINGS = 3
 
 
 class ContactTerm:
@@ -112,25 +107,12 @@ class ContactTerm:
                  quadratic_transform: bool = False,
                  boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, axisymmetric: bool = False):
-        if not isinstance(u, fem.Function):
-            raise TypeError(f"u must be a dolfinx.fem.Function (the displacement), got "
-                            f"{type(u).__name__}")
-        V = u.function_space
-        mesh = V.mesh
-        gdim = mesh.geometry.dim
-        if V.dofmap.index_map_bs != gdim:
-            raise ValueError(f"u must be a vector Function with {gdim} components per node")
-        if (master_tag is None) == (obstacle is None):
-            raise ValueError("give exactly one of master_tag (elastic master) and obstacle "
-                             "(rigid analytic obstacle)")
-        if obstacle is not None and obstacle.gdim != gdim:
-            raise ValueError(f"a {obstacle.gdim}D obstacle in a {gdim}D mesh: the option "
-                             "does not fit the mesh's dimension")
+        check_contact_arguments(u, master_tag, obstacle, axisymmetric)
         options = ContactOptions.checked(kind, penalty, scaling, active_set,
                                          basis_configuration, boundary_modification,
                                          search_radius, master_tag is not None, axisymmetric)
-        if axisymmetric and gdim != 2:
-            raise ValueError(f"axisymmetric contact needs a 2D (r, z) mesh, got a {gdim}D one")
+        V = u.function_space
+        mesh = V.mesh
         check_cells(mesh)
         check_contact_tags(mesh, facet_tags, slave_tag, master_tag)
         self.u, self.V, self.mesh = u, V, mesh
@@ -151,9 +133,6 @@ class ContactTerm:
         #: whether the last :meth:`assemble_jacobian` changed the matrix's
         #: nonzero pattern in a way PETSc does not see (the KSP must be reset)
         self.pattern_changed = False
-        #: times the default search radius was widened, and whether reaching it was warned
-        self._radius_widenings = 0
-        self._radius_warned = False
         #: what the term reports (pressures, forces, slip, …)
         self.results = ContactResults(self)
         #: its checks of the model's range
@@ -193,38 +172,13 @@ class ContactTerm:
         self.model = model
         return True
 
-    def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:
-        """Called by a load-path driver after a converged step: where the contact
-        zone reached slave nodes that found no master within the search radius
-        though one lies beyond it
-        (:meth:`RangeChecks.contact_reached_the_search_radius
-        <dolfinx_mortar.contact.checks.RangeChecks.contact_reached_the_search_radius>`),
-        rebuild the frozen bases with four times the radius and return True (the
-        step must be solved again, with a new matrix pattern). A radius the user
-        gave is kept, with a warning; so is one already widened
-        MAX_RADIUS_WIDENINGS times (collective)."""
-        if self._radius_warned or not (
-                self.checks.contact_reached_the_search_radius(state)):
-            return False
-        radius = self.model.coupling.search_radius
-        widenings = self._radius_widenings
-        if self.options.search_radius is None or widenings > 0:
-            if widenings < MAX_RADIUS_WIDENINGS:
-                self._radius_widenings = widenings + 1
-                self.options = replace(self.options, search_radius=4 * radius)
-                self.model = self._timed_build(self.configuration.rebuild, self.options)
-                if self.mesh.comm.rank == 0:
-                    logger.info("the contact zone reached slave nodes with no master within "
-                                "the search radius %.3g: bases rebuilt with %.3g, step "
-                                "solved again", radius, 4 * radius)
-                return True
-        self._radius_warned = True
-        warnings.warn(f"the contact zone reached slave nodes that found no master within "
-                      f"the search radius {radius:.3g}, though a master lies beyond it: the "
-                      f"pressure is cut off there. Pass a larger search_radius (e.g. "
-                      f"{4 * radius:.3g}) or basis_configuration='previous'",
-                      RuntimeWarning, stacklevel=3)
-        return False
+    def rebuild(self, search_radius: float) -> None:
+        """The bases and segmentation made again with another search radius, in
+        the configuration they were built in (a widened default radius:
+        :meth:`RangeChecks.widen_search_radius
+        <dolfinx_mortar.contact.checks.RangeChecks.widen_search_radius>`)."""
+        self.options = replace(self.options, search_radius=search_radius)
+        self.model = self._timed_build(self.configuration.rebuild, self.options)
 
     @contextmanager
     def frozen(self) -> Iterator[None]:

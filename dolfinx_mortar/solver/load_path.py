@@ -263,7 +263,7 @@ class LoadPathSolver:
                     x.copy(u.x.petsc_vec)
                     u.x.scatter_forward()
                     states = [term.evaluate() for term in self.contacts]
-                    if any([term.widen_search_radius(state)
+                    if any([term.checks.widen_search_radius(state)
                             for term, state in zip(self.contacts, states)]):
                         # the bases were cut off by the search radius: the same step again
                         saved.copy(u.x.petsc_vec)

@@ -16,13 +16,8 @@ namespace dolfinx_mortar
 {
 namespace detail
 {
-/// The chain rule for f(y(z)) with f's gradient @p gf (m) and Hessian @p Hf
-/// (m × m) in y, where y_i is either the node coordinate z_{column[i]}
-/// (column[i] ≥ 0) or a function of z with gradient row i of @p J (m × K)
-/// and Hessian @p Hy[i] (K × K; null if zero):
-/// g = Jᵀ gf, H = Jᵀ Hf J + Σ_i gf_i Hy_i. The coordinate rows are unit
-/// rows of J, and are applied as such (a third of the dense product's cost
-/// on a 3D pair).
+// The coordinate rows are unit rows of J, and are applied as such (a third of
+// the dense product's cost on a 3D pair).
 void
 compose(int m,
         int K,
