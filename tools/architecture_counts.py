@@ -28,7 +28,8 @@ OWNERS = {"contact/configuration.py", "contact/newton_entry.py", "contact/option
 #: the penalty law's own module
 LAW = "contact/penalty_law.py"
 #: the current configuration's Python
-CURRENT = ("contact/finite_deformation.py", "contact/current_mortar.py")
+CURRENT = ("contact/finite_deformation.py", "contact/current_obstacle.py",
+           "contact/current_mortar.py")
 #: keys of the dictionaries the kernels' bindings return
 KERNEL_KEYS = ("value", "gradient", "hessian", "nodes", "value_plus", "gradient_plus", "gap",
                "normals", "weights", "pairs", "slave_N", "master_N", "D", "M", "g")

@@ -38,7 +38,9 @@ class CurrentObstacleGap(CurrentSurfaceGap):
         super().__init__(slave, kind, law, quadrature_degree)
         self.obstacle = obstacle
 
-    def _obstacle_at(self, points: FloatArray) -> ObstaclePoints:
+    def _obstacle_at(self, x: FloatArray) -> ObstaclePoints:
+        # the points are needed here only: a master's gap has its own
+        points = np.einsum("qb,cbi->cqi", self.N, x)
         nc, nq, gdim = points.shape
         flat = points.reshape(-1, gdim)
         return ObstaclePoints(-self.obstacle.signed_distance(flat).reshape(nc, nq),

@@ -172,9 +172,10 @@ class CurrentSurfaceGap(GapModelBase):
         self.cell_dofs = self.node_dofs(cells).reshape(nc, nd * gdim)
 
     # -- what a gap source provides ------------------------------------------------------
-    def _obstacle_at(self, points: FloatArray) -> Optional[ObstaclePoints]:
-        """A rigid obstacle's gap at the cells' current quadrature points
-        (cells, points, gdim); None where the gap comes from a master."""
+    def _obstacle_at(self, x: FloatArray) -> Optional[ObstaclePoints]:
+        """A rigid obstacle's gap at the quadrature points of the cells with
+        current nodes ``x`` (cells, nodes, gdim); None where the gap comes
+        from a master."""
         return None
 
     def _gap(self, u_nodes: FloatArray, W: FloatArray,
@@ -199,7 +200,7 @@ class CurrentSurfaceGap(GapModelBase):
         exact gradients (the kernels' Jets; the Hessians on demand, in
         :meth:`_cell_hessians`)."""
         x = np.ascontiguousarray((self.slave.x + u_nodes)[self.slave.cells])
-        obstacle = self._obstacle_at(np.einsum("qb,cbi->cqi", self.N, x))
+        obstacle = self._obstacle_at(x)
         extra = obstacle.kernel_arguments() if obstacle is not None else {}
         cells = _kernels.current_surface_cells(
             x, self.N, self.dN, self.wq, self.phi, self.slave.axisymmetric,
