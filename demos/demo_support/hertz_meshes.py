@@ -90,3 +90,52 @@ def quarter_disk_mesh(radius: float, a: float, h_contact: float, lower: str, deg
     finally:
         gmsh.finalize()
     return domain, facet_tags
+
+
+def half_disk_pair_mesh(radius: float, a: float, h_contact: float, degree: int,
+                        comm: MPI.Comm):
+    """Two equal half disks touching at the origin: the upper one
+    {y ≤ R, x² + (y − R)² ≤ R²} and its mirror about y = 0, graded towards the
+    contact point as :func:`quarter_disk_mesh` (without a symmetry plane: a
+    tangential load is not symmetric).
+
+    Returns the DOLFINx mesh and its facet tags: SLAVE (the upper arc), MASTER
+    (the lower arc), LOAD (y = R), FIXED (y = −R).
+    """
+    import gmsh
+    from dolfinx_mortar.io.gmsh_io import model_to_mesh
+    from dolfinx_mortar.io.gmsh_io import grade_towards_point
+    R = radius
+    gmsh.initialize(["", "-v", "0"])
+    try:
+        if comm.rank == 0:
+            occ = gmsh.model.occ
+            upper, _ = occ.intersect([(2, occ.addDisk(0, R, 0, R, R))],
+                                     [(2, occ.addRectangle(-R, 0, 0, 2 * R, R))])
+            lower, _ = occ.intersect([(2, occ.addDisk(0, -R, 0, R, R))],
+                                     [(2, occ.addRectangle(-R, -R, 0, 2 * R, R))])
+            occ.synchronize()
+            tags: dict = {SLAVE: [], MASTER: [], LOAD: [], FIXED: []}
+            tol = 1e-6 * R
+            for _, curve in gmsh.model.getEntities(1):
+                _, y, _ = occ.getCenterOfMass(1, curve)
+                if abs(y - R) < tol:
+                    tags[LOAD].append(curve)
+                elif abs(y + R) < tol:
+                    tags[FIXED].append(curve)
+                elif y > 0:
+                    tags[SLAVE].append(curve)
+                else:
+                    tags[MASTER].append(curve)
+            for tag, curves in tags.items():
+                gmsh.model.addPhysicalGroup(1, curves, tag)
+            gmsh.model.addPhysicalGroup(2, [upper[0][1]], 10)
+            gmsh.model.addPhysicalGroup(2, [lower[0][1]], 11)
+            grade_towards_point((0, 0, 0), h_contact, R / 8, 1.5 * a, 1.5 * a + 40 * (R / 8))
+            gmsh.model.mesh.generate(2)
+            if degree == 2:
+                gmsh.model.mesh.setOrder(2)
+        domain, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
+    finally:
+        gmsh.finalize()
+    return domain, facet_tags

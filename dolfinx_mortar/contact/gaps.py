@@ -293,6 +293,9 @@ class MortarGap(GapModelBase):
         cols = np.concatenate([slave_dofs, master_dofs], axis=1).reshape(npairs, width)
         self.G = assemble_blocks(self.slave.layout, slave_cells, self.dofs, cols,
                                  blocks.reshape(npairs, ns, width))
+        #: the pairs' slave cells, their columns (slave then master dofs) and
+        #: the scalar couplings ``[D̄ | −M̄]`` (pairs, ns, ns + nm): friction's slip
+        self.pair_operators = (slave_cells, cols, np.concatenate([Dg, -Mg], axis=2))
         #: the segment points for the pointwise active set (None: nodal only)
         self.points = None
         if self.pointwise:

@@ -56,16 +56,25 @@ class AssembledEntry:
         #: stiffened (for the contact block preconditioner)
         self.stiffened_rows: np.ndarray = np.zeros(0, dtype=PETSc.IntType)
 
-    def add_pattern(self, A: PETSc.Mat, model: GapModel, state: ContactState) -> None:
-        """Give the bulk matrix ``A`` every entry the contact stiffness may have."""
+    def add_pattern(self, A: PETSc.Mat, model: GapModel, state: ContactState,
+                    friction=None) -> None:
+        """Give the bulk matrix ``A`` every entry the contact stiffness may have
+        (friction's too, where there is friction)."""
         A.axpy(1.0, model.pattern(state), structure=DIFFERENT)
+        if friction is not None:
+            A.axpy(1.0, friction.pattern(model, state, state.friction), structure=DIFFERENT)
 
     def assemble(self, A: PETSc.Mat, model: GapModel, state: ContactState, active: FloatArray,
-                 mask: PETSc.Vec, configuration) -> bool:
-        """``A += K_c`` at ``state`` with ``active`` as H(d̄) (A assembled after);
-        returns whether A's pattern changed unseen by PETSc."""
+                 mask: PETSc.Vec, configuration, friction=None) -> bool:
+        """``A += K_c`` at ``state`` with ``active`` as H(d̄) (A assembled after),
+        with ``friction``'s (:class:`~dolfinx_mortar.contact.friction.Friction`)
+        stiffness where given; returns whether A's pattern changed unseen by PETSc."""
         geometric = configuration.geometric_stiffness(active, self.comm)
         K = model.jacobian(state, active, mask, geometric=geometric)
+        if friction is not None:
+            K = K.copy()  # the model's product keeps its own matrix for reuse
+            K.axpy(1.0, friction.jacobian(model, state, state.friction, active),
+                   structure=DIFFERENT)
         self.stiffened_rows = stiffened_rows(K, self.bs)
         changed = configuration.add_stiffness(A, K)
         A.assemble()
@@ -88,11 +97,12 @@ class AugmentedEntry(AssembledEntry):
         #: the exact Newton step of the last :meth:`assemble`
         self.step = AugmentedNewtonStep(comm, self.prefix)
 
-    def add_pattern(self, A: PETSc.Mat, model: GapModel, state: ContactState) -> None:
+    def add_pattern(self, A: PETSc.Mat, model: GapModel, state: ContactState,
+                    friction=None) -> None:
         """Nothing: the contact stiffness never enters the bulk matrix."""
 
     def assemble(self, A: PETSc.Mat, model: GapModel, state: ContactState, active: FloatArray,
-                 mask: PETSc.Vec, configuration) -> bool:
+                 mask: PETSc.Vec, configuration, friction=None) -> bool:
         self.step.update_from(A, state, model, active)
         return False
 

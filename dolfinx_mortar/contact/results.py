@@ -132,6 +132,86 @@ class ContactResults:
         return int(self.term.mesh.comm.allreduce(
             int(np.sum(p[: self.term.slave.layout.num_owned] > 0))))
 
+    # -- friction -----------------------------------------------------------------------
+    def _friction(self, state: Optional[ContactState]):
+        if self.term.friction is None:
+            raise ValueError("this contact term has no friction (ContactTerm(..., "
+                             "friction=CoulombFriction(mu)))")
+        return (state or self.term.evaluate()).friction
+
+    def tangential_tractions(self, state: Optional[ContactState] = None) -> FloatArray:
+        """``q_A = −f_T,A / W_A^k``: the coefficients of the tangential traction
+        on the slave body in the partition-of-unity basis, as ``p_A`` is of the
+        pressure, at the local slave-layout nodes, (nodes, gdim); it opposes
+        the slave's slip relative to what it touches, and ``|q_A| ≤ μ p_A``."""
+        state = state or self.term.evaluate()
+        W = state.lumped_weights
+        force = -self._friction(state).mapping.force
+        if self.term.options.law.k == 0:
+            return force.copy()
+        q = np.zeros_like(force)
+        np.divide(force, W[:, None], out=q, where=(W > 0)[:, None])
+        return q
+
+    def slip_states(self, state: Optional[ContactState] = None) -> npt.NDArray[np.int8]:
+        """Per local slave-layout node: 0 separated, 1 stick, 2 slip
+        (:data:`~dolfinx_mortar.contact.friction_law.STICK`, …)."""
+        return self._friction(state).mapping.state.copy()
+
+    def tangential_force(self, state: Optional[ContactState] = None) -> FloatArray:
+        """The resultant of the tangential (friction) traction on the slave
+        body, a gdim-vector over all ranks: ``−Σ G_Tᵀ f_T`` over the slave
+        nodes' dofs, as :meth:`contact_force` is of the whole traction."""
+        friction = self._friction(state)
+        gdim = self.term.slave.gdim
+        R = friction.residual.array_r.reshape(-1, gdim)
+        nodes = np.unique(self.term.slave.cells)
+        nodes = nodes[nodes < self.term.slave.layout.num_owned]
+        local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
+        return np.asarray(self.term.mesh.comm.allreduce(local))
+
+    def dissipation(self) -> float:
+        """The frictional dissipation ``Σ_steps Σ_A f_T,A · Δy_p,A`` over the
+        accepted steps, over all ranks."""
+        if self.term.friction is None:
+            return 0.0
+        return self.term.friction.history.dissipation
+
+    def stored_energy(self, state: Optional[ContactState] = None) -> float:
+        """The energy stored in the contact's penalty springs over all ranks:
+        ``Σ_A (ω_A/2)⟨y_A⟩²`` (normal) plus, with friction,
+        ``Σ_A |f_T,A|²/(2ω_T,A)`` (tangential); for the nodal active set on
+        frozen bases, where the normal law has this potential."""
+        state = state or self.term.evaluate()
+        if self.term.options.law.pointwise or self.term.configuration.follows_u:
+            raise NotImplementedError("the stored energy is that of the nodal active set on "
+                                      "frozen bases ('initial' or 'previous')")
+        n = self.term.slave.layout.num_owned
+        normal = 0.5 * np.sum((state.weights * np.maximum(state.gaps, 0.0) ** 2)[:n])
+        energy = float(self.term.mesh.comm.allreduce(float(normal)))
+        if self.term.friction is not None:
+            energy += self.term.friction.stored_energy(state.friction)
+        return energy
+
+    def friction_summary(self, state: Optional[ContactState] = None) -> Optional[dict]:
+        """The friction figures of a step, for the load path's history: None
+        without friction, else ``tangential_force`` (list), ``dissipation``
+        (total), ``step_dissipation``, ``stick_nodes``, ``slip_nodes``,
+        ``tangential_energy`` (the tangential springs' stored energy)."""
+        if self.term.friction is None:
+            return None
+        state = state or self.term.evaluate()
+        n = self.term.slave.layout.num_owned
+        states = self.slip_states(state)[:n]
+        comm = self.term.mesh.comm
+        history = self.term.friction.history
+        return {"tangential_force": self.tangential_force(state).tolist(),
+                "dissipation": history.dissipation,
+                "step_dissipation": history.step_dissipation,
+                "stick_nodes": int(comm.allreduce(int(np.sum(states == 1)))),
+                "slip_nodes": int(comm.allreduce(int(np.sum(states == 2)))),
+                "tangential_energy": self.term.friction.stored_energy(state.friction)}
+
     def node_lengths(self) -> FloatArray:
         """Each local slave node's element length: the largest of its cells'."""
         slave = self.term.slave

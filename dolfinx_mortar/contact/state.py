@@ -52,6 +52,9 @@ class ContactState:
     lumped_weights: Optional[FloatArray] = None
     covered: Optional[npt.NDArray[np.bool_]] = None
     coefficients: Optional[FloatArray] = None
+    #: friction at this displacement (a
+    #: :class:`~dolfinx_mortar.contact.friction.FrictionState`; None: frictionless)
+    friction: Any = None
 
 
 class GapModel(Protocol):

@@ -31,6 +31,8 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.active_set import gap_closing_force, stiffened_nodes
 from dolfinx_mortar.contact.checks import RangeChecks
 from dolfinx_mortar.contact.configuration import configuration_of
+from dolfinx_mortar.contact.friction import Friction
+from dolfinx_mortar.contact.friction_law import CoulombFriction
 from dolfinx_mortar.contact.newton_entry import entry_of
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
@@ -98,6 +100,10 @@ class ContactTerm:
         forces are those on the whole body (docs/AXISYMMETRIC.md). The user's bulk form
         must be axisymmetric too
         (:func:`~dolfinx_mortar.small_strain.elastic.axisymmetric_elastic_residual`).
+    friction
+        Coulomb friction (:class:`~dolfinx_mortar.contact.friction_law.CoulombFriction`:
+        μ and the tangential penalty), or None (frictionless, default). Its
+        history moves on in :meth:`accept_step` (docs/FRICTION.md).
     """
 
     def __init__(self, u: fem.Function, facet_tags, slave_tag: int, *,
@@ -106,8 +112,12 @@ class ContactTerm:
                  active_set: str = "nodal", basis_configuration: str = "initial",
                  quadratic_transform: bool = False,
                  boundary_modification: Optional[bool] = None,
-                 search_radius: Optional[float] = None, axisymmetric: bool = False):
+                 search_radius: Optional[float] = None, axisymmetric: bool = False,
+                 friction: Optional[CoulombFriction] = None):
         check_contact_arguments(u, master_tag, obstacle, axisymmetric)
+        if friction is not None and not isinstance(friction, CoulombFriction):
+            raise TypeError(f"friction must be a CoulombFriction or None, got "
+                            f"{type(friction).__name__}")
         options = ContactOptions.checked(kind, penalty, scaling, active_set,
                                          basis_configuration, boundary_modification,
                                          search_radius, master_tag is not None, axisymmetric)
@@ -137,6 +147,10 @@ class ContactTerm:
         self.results = ContactResults(self)
         #: its checks of the model's range
         self.checks = RangeChecks(self)
+        #: Coulomb friction and its history (None: frictionless)
+        self.friction: Optional[Friction] = (
+            Friction(friction, options, u, self.slave, obstacle) if friction is not None
+            else None)
         self.model: GapModel = self._timed_build(self.configuration.build, options)
         self.checks.warn_deep_initial_penetration()
         self.checks.warn_if_no_master_is_in_reach(self.configuration.segmentation(self.model))
@@ -205,12 +219,37 @@ class ContactTerm:
     def symmetric(self) -> bool:
         """Whether the contact Jacobian is symmetric: the nodal active set on
         frozen bases."""
-        return not (self.options.law.pointwise or self.configuration.follows_u)
+        return not (self.options.law.pointwise or self.configuration.follows_u
+                    or self.friction is not None)
 
     def evaluate(self) -> ContactState:
         """The contact state at the present u with every dof kept (results)."""
         self.u.x.scatter_forward()
-        return self.model.evaluate(self.u, None)
+        return self._with_friction(self.model.evaluate(self.u, None), None)
+
+    def _with_friction(self, state: ContactState, mask: Optional[PETSc.Vec]) -> ContactState:
+        """The state with friction's forces in its residual (as it is without friction)."""
+        if self.friction is None:
+            return state
+        if mask is None and self.friction.at_accepted_step(self.u):
+            # a result at a converged step: its own return mapping, not one
+            # with its forces already made history
+            friction = self.friction.history.accepted
+        else:
+            friction = self.friction.evaluate(self.model, state, self.u,
+                                              self.active_nodes_mask(state), mask)
+        state.residual.axpy(1.0, friction.residual)
+        state.friction = friction
+        return state
+
+    def accept_step(self, state: Optional[ContactState] = None) -> None:
+        """The present u is a converged load step: friction's history (the
+        tangential forces, the step's dissipation) moves on to it. A load-path
+        driver calls it once per accepted step, never after a failed one, so
+        that a cut-back retries from the same history. Without friction,
+        nothing happens."""
+        if self.friction is not None:
+            self.friction.accept((state or self.evaluate()).friction, self.u)
 
     # -- PETSc assembly --------------------------------------------------------------
     def mask(self, bcs: Sequence[fem.DirichletBC] = ()) -> PETSc.Vec:
@@ -236,7 +275,8 @@ class ContactTerm:
         # on 2 ranks of 3.22 by 0.5 MB per evaluation). An evaluation is
         # collective, so every rank reaches this point together.
         PETSc.garbage_cleanup(self.mesh.comm)
-        self.state = self.model.evaluate(self.u, self.mask(bcs))
+        mask = self.mask(bcs)
+        self.state = self._with_friction(self.model.evaluate(self.u, mask), mask)
         self._add("residual", clock)
         return self.state
 
@@ -260,7 +300,8 @@ class ContactTerm:
         state = self.state
         self.pattern_changed = self.entry.assemble(A, self.model, state,
                                                    self.active_nodes_mask(state),
-                                                   self.mask(bcs), self.configuration)
+                                                   self.mask(bcs), self.configuration,
+                                                   self.friction)
         self._add("jacobian", clock)
 
     @property
@@ -280,7 +321,7 @@ class ContactTerm:
         A = fem_petsc.create_matrix(a)
         fem_petsc.assemble_matrix(A, a, list(bcs))
         A.assemble()
-        self.entry.add_pattern(A, self.model, self.state or self.update(bcs))
+        self.entry.add_pattern(A, self.model, self.state or self.update(bcs), self.friction)
         self.configuration.new_matrix()
         if self.moving_pattern or self.configuration.pattern_grows:
             # the pairs, and so the pattern, change with u: new entries are

@@ -1,5 +1,9 @@
 """XDMF output of a contact solve: u and p̂ on the mesh, p̂ and p* on the slave facets.
 
+With friction the slave facets carry the tangential traction ``q_hat_x``,
+``q_hat_y`` (``q_hat_z``) and the nodes' ``stick_slip`` state (0 separated,
+1 stick, 2 slip) too.
+
 Every converged step goes to ``<output>.xdmf`` (displacement and nodal
 pressure on the mesh) and to ``<output>_slave.xdmf`` (``p_hat`` and ``p_star``
 per slave facet, since ``p*`` may jump); with several contact terms the
@@ -68,8 +72,15 @@ class ContactOutput:
         for term, state, out in zip(self.contacts, states, self.surface_outputs):
             pressures = term.results.nodal_pressures(state)
             total += pressures
-            out.write({"p_hat": pressures[term.slave.cells],
-                       "p_star": term.results.mortar_traction(state)}, t)
+            fields = {"p_hat": pressures[term.slave.cells],
+                      "p_star": term.results.mortar_traction(state)}
+            if term.friction is not None:
+                # the tangential traction by component and the stick (1) / slip (2) state
+                q = term.results.tangential_tractions(state)
+                for k, axis in enumerate("xyz"[: q.shape[1]]):
+                    fields[f"q_hat_{axis}"] = q[term.slave.cells, k]
+                fields["stick_slip"] = term.results.slip_states(state)[term.slave.cells]
+            out.write(fields, t)
         u1 = fem.Function(self.V1, name="displacement")
         u1.interpolate(self.u)
         p = fem.Function(self.Q, name="contact_pressure")

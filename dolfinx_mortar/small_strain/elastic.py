@@ -19,6 +19,7 @@ import ufl
 from dolfinx import fem
 from petsc4py import PETSc
 
+from dolfinx_mortar.contact.friction_law import CoulombFriction
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.input_checks import check_boundary_data, check_tags
@@ -53,7 +54,7 @@ class ContactProblem:
     V
         Vector Lagrange function space of degree 1 or 2 for the displacement.
     facet_tags, slave_tag, master_tag, obstacle, kind, penalty, scaling, active_set,
-    basis_configuration, quadratic_transform, boundary_modification, search_radius
+    basis_configuration, quadratic_transform, boundary_modification, search_radius, friction
         The contact term's (:class:`~dolfinx_mortar.contact.term.ContactTerm`).
     E, nu
         Young's modulus and Poisson's ratio.
@@ -81,7 +82,8 @@ class ContactProblem:
                  quadratic_transform: bool = False,
                  boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, petsc_options: Optional[dict] = None,
-                 axisymmetric: bool = False, linear_solver: str = "auto"):
+                 axisymmetric: bool = False, linear_solver: str = "auto",
+                 friction: Optional[CoulombFriction] = None):
         mesh = V.mesh
         gdim = mesh.geometry.dim
         if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
@@ -101,7 +103,7 @@ class ContactProblem:
             kind=kind, penalty=penalty, scaling=scaling, active_set=active_set,
             basis_configuration=basis_configuration, quadratic_transform=quadratic_transform,
             boundary_modification=boundary_modification, search_radius=search_radius,
-            axisymmetric=axisymmetric)
+            axisymmetric=axisymmetric, friction=friction)
         #: the load factor, 0 … 1
         self.load = fem.Constant(mesh, PETSc.ScalarType(0.0))
         v = ufl.TestFunction(V)

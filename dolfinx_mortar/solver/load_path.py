@@ -83,6 +83,7 @@ class LoadPathSolver:
         #: the line search of the last :meth:`create_snes` (None where the user
         #: chose one: :meth:`library_line_search`)
         self.line_search: Optional[FullStepFirst] = None
+        self._force_scale = 0.0
 
     @property
     def contacts(self):
@@ -212,6 +213,8 @@ class LoadPathSolver:
         if predictor not in ("none", "linear"):
             raise ValueError(f"predictor must be 'none' or 'linear', not {predictor!r}")
         stepper = LoadStepper(load_steps, max_cuts)
+        # the largest out-of-balance force a step of this solve started with
+        self._force_scale = 0.0
         u = self.problem.u
         if not np.all(np.isfinite(u.x.array)):
             raise ValueError("the displacement contains NaN or infinite values")
@@ -271,6 +274,8 @@ class LoadPathSolver:
                         snes.setJacobian(lambda _s, x, A, P: self.problem.J(x, A, _s.getKSP()),
                                          self.problem.refresh_matrix())
                         continue
+                    for term, state in zip(self.contacts, states):
+                        term.accept_step(state)
                     if path is not None:
                         path.converged(target, u.x.petsc_vec)
                     deepest = [max(worst, term.results.penetration(state), key=lambda d: d[0])
@@ -278,7 +283,9 @@ class LoadPathSolver:
                     active = sum(t.results.active_nodes(s) for t, s in zip(self.contacts, states))
                     step = StepResult(target, outcome.iterations, outcome.residuals,
                                       time.perf_counter() - clock, active, outcome.phases,
-                                      outcome.reference, outcome.linear_iterations)
+                                      outcome.reference, outcome.linear_iterations,
+                                      [t.results.friction_summary(s)
+                                       for t, s in zip(self.contacts, states)])
                     result.steps.append(step)
                     before = stepper.fraction_of_steps
                     stepper.succeeded()
@@ -319,6 +326,12 @@ class LoadPathSolver:
         b = self.problem.vector()
         self.problem.F(x, b)
         reference = b.norm()
+        if reference <= self.equilibrium.floor_rtol * self._force_scale:
+            # a step that changes nothing (a hold, Q = 0 after P): the start is
+            # at the round-off floor of the forces met so far, and its own
+            # round-off residual is no scale to reduce (it failed at stol)
+            reference = self._force_scale
+        self._force_scale = max(self._force_scale, reference)
         self.equilibrium.start(reference)
         if increment is not None:
             x.axpy(1.0, increment)

@@ -49,6 +49,11 @@ class StepResult:
     reference: float = float("nan")
     #: Krylov iterations of the step's linear solves (1 per Newton iteration with LU)
     linear_iterations: int = 0
+    #: per contact term with friction (None without): the tangential force
+    #: resultant on the slave body, the step's and the total frictional
+    #: dissipation, and the numbers of sticking and slipping nodes
+    #: (:meth:`~dolfinx_mortar.contact.results.ContactResults.friction_summary`)
+    friction: list = field(default_factory=list)
 
     def terminal_iterations(self, near: float = 1e-3) -> int:
         """Newton iterations of the step's last solve after its residual first

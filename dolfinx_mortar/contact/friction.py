@@ -1,0 +1,357 @@
+"""Coulomb friction of a contact term: the tangential slip, its history, and
+the tangential residual and exact Jacobian (docs/FRICTION.md).
+
+The slip increment of slave node A over a load step is the mortar-weighted
+relative displacement increment projected on the node's tangent plane where
+the step starts:
+
+    Δy_T,A = P_A (Σ_B D̄_AB Δu_B − Σ_C M̄_AC Δu_C),   P_A = I − n_A ⊗ n_A,
+
+with the gap model's own frozen mortar integrals (``D̄_AB = ∫ M̄_A N_B``,
+``M̄_AC = ∫ M̄_A N^m_C``; against a rigid obstacle ``−(∫ M̄_A) Δc``, Δc the
+obstacle's translation). It is objective in the sense the frozen
+configurations are: a rigid translation of both bodies gives no slip, since
+the rows of D̄ and M̄ integrate the same function over the covered part, and
+the mortar weighting makes it independent of where the master mesh's nodes
+lie. Tangential forces follow from the return mapping of
+:mod:`~dolfinx_mortar.contact.friction_law`; with ``f_N = ω⟨y⟩`` the
+contact's normal nodal forces,
+
+- residual ``R_T = G_Tᵀ f_T`` with ``G_T = ∂Δy_T/∂u`` (linear: frozen
+  normals and integrals within a step),
+- Jacobian ``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ωH G)``, unsymmetric in slip.
+
+The history (the tangential forces and the displacement of the last accepted
+step) changes only in :meth:`Friction.accept`, called by the load-path driver
+when a step has converged: a cut-back retries from the same history.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from dolfinx_mortar.contact.friction_law import CoulombFriction, ReturnMapping
+from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
+from dolfinx_mortar.contact.options import ContactOptions
+from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.kinds import is_global, kind_name
+from dolfinx_mortar.layout import assemble_blocks
+from dolfinx_mortar.linalg.sparse_products import transpose_mat_mult
+from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
+
+FloatArray = npt.NDArray[np.float64]
+DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+
+
+def check_friction_options(options: ContactOptions) -> None:
+    """NotImplementedError naming a combination friction does not support, and why."""
+    if is_global(options.kind):
+        raise NotImplementedError(
+            f"friction with {kind_name(options.kind)}: the tangential forces of the global "
+            "kinds act through L⁻¹ (dense), which the augmented Newton step does not carry "
+            "for the tangential directions; use a local kind (LmLS*, LmLS, LcLS*, LcLS)")
+    if options.law.pointwise:
+        raise NotImplementedError("friction with active_set='pointwise': the Coulomb cone is "
+                                  "set by the nodal normal forces; use active_set='nodal'")
+    if options.basis_configuration == "current":
+        raise NotImplementedError(
+            "friction with basis_configuration='current': the slip on the current surface "
+            "needs the derivatives of its tangent planes and mortar integrals in the "
+            "tangential directions, which the kernels do not give yet; use 'previous' "
+            "(the tangent planes follow each converged step) or 'initial'")
+
+
+@dataclass
+class FrictionHistory:
+    """What friction remembers of the last accepted step.
+
+    Attributes
+    ----------
+    forces
+        The tangential nodal forces ``f_T`` at the local slave-layout nodes, (nodes, gdim).
+    u
+        The displacement vector of that step.
+    u_nodes
+        The same at the local slave-layout nodes, (nodes, gdim).
+    obstacle_displacement
+        The rigid obstacle's translation then (None against an elastic master).
+    dissipation
+        The frictional dissipation since the start, summed over all ranks.
+    step_dissipation
+        That of the last accepted step.
+    version
+        Counts the accepted steps.
+    accepted
+        The friction state of the last accepted step (None before the first):
+        what a result at that displacement reports, since evaluated again there
+        with its own forces as history every slipping node would sit on the
+        cone and count as sticking.
+    """
+
+    forces: FloatArray
+    u: PETSc.Vec
+    u_nodes: FloatArray
+    obstacle_displacement: Optional[FloatArray]
+    dissipation: float = 0.0
+    step_dissipation: float = 0.0
+    version: int = 0
+    accepted: Optional["FrictionState"] = None
+
+
+@dataclass
+class FrictionState:
+    """Friction at one displacement (part of a
+    :class:`~dolfinx_mortar.contact.state.ContactState`).
+
+    Attributes
+    ----------
+    slip_increment
+        ``Δy_T`` per local node since the last accepted step, (nodes, gdim).
+    mapping
+        The return mapping's forces, derivatives and stick/slip states.
+    G_T
+        ``∂Δy_T/∂u`` (rows: node·gdim + i), Dirichlet columns dropped.
+    tangential_weights
+        ``ω_T = ε_T W^m`` per node.
+    projected_history
+        ``P_A f_T,A^n``: the last accepted forces in the present tangent planes.
+    residual
+        ``G_Tᵀ f_T``, friction's part of the contact residual.
+    """
+
+    slip_increment: FloatArray
+    mapping: ReturnMapping
+    G_T: PETSc.Mat
+    tangential_weights: FloatArray
+    projected_history: FloatArray
+    residual: Optional[PETSc.Vec] = None
+
+
+@dataclass
+class _SlipOperator:
+    """The linear map of a step: ``Δy_T = to_local(G_T Δu) + shift (Δc)``."""
+
+    G_T: PETSc.Mat
+    projectors: FloatArray              # P_A, (nodes, gdim, gdim)
+    obstacle_weights: Optional[FloatArray]  # (∫ M̄_A) P_A for the obstacle's motion
+
+
+def _projectors(normals: FloatArray) -> FloatArray:
+    gdim = normals.shape[1]
+    return np.eye(gdim)[None] - normals[:, :, None] * normals[:, None, :]
+
+
+class Friction:
+    """Coulomb friction of one contact term (see the module).
+
+    Parameters
+    ----------
+    law
+        μ and ε_T.
+    options
+        The contact term's options (checked here for what friction supports).
+    u
+        The displacement Function (its present value starts the history).
+    obstacle
+        The term's rigid obstacle, or None.
+    """
+
+    def __init__(self, law: CoulombFriction, options: ContactOptions, u, slave, obstacle=None):
+        check_friction_options(options)
+        self.law = law
+        self.normal_law = options.law
+        #: ε_T
+        self.penalty = law.penalty(options.penalty)
+        self.slave, self.obstacle = slave, obstacle
+        self.comm: MPI.Comm = slave.layout.comm
+        u.x.scatter_forward()
+        self.history = FrictionHistory(
+            np.zeros((slave.layout.size_local, slave.gdim)), u.x.petsc_vec.copy(),
+            nodal_displacement(slave, u),
+            None if obstacle is None else np.array(obstacle.displacement, dtype=float))
+        self._operator: Optional[_SlipOperator] = None
+        #: the stick/slip states of the last Jacobian (the exact slip tangent
+        #: once they repeat)
+        self._jacobian_states: Optional[npt.NDArray[np.int8]] = None
+        self._operator_key: tuple = ()
+
+    # -- the slip operator of a step ---------------------------------------------------
+    def _slip_operator(self, model) -> _SlipOperator:
+        key = (model, self.history.version if isinstance(model, ObstacleGap) else -1)
+        if self._operator is None or self._operator_key[0] is not key[0] \
+                or self._operator_key[1] != key[1]:
+            self._operator = (self._obstacle_operator(model) if isinstance(model, ObstacleGap)
+                              else self._mortar_operator(model))
+            self._operator_key = key
+        return self._operator
+
+    def _assemble(self, model, cells, cols, blocks, projectors) -> PETSc.Mat:
+        """G_T from scalar node couplings ``blocks`` (cells, rows, cols) times P_A."""
+        gdim = self.slave.gdim
+        nc, nr = cells.shape
+        values = np.einsum("can,caik->caink", blocks, projectors[cells])
+        rows = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, nr * gdim)
+        return assemble_blocks(model.dofs, rows, model.dofs, cols,
+                               values.reshape(nc, nr * gdim, cols.shape[1]))
+
+    def _mortar_operator(self, model: MortarGap) -> _SlipOperator:
+        cells, cols, blocks = model.pair_operators
+        projectors = _projectors(model.coupling.normals)
+        return _SlipOperator(self._assemble(model, cells, cols, blocks, projectors),
+                             projectors, None)
+
+    def _obstacle_operator(self, model: ObstacleGap) -> _SlipOperator:
+        """Tangent planes of the obstacle below each node where the step starts
+        (the obstacle translated back to where it was then)."""
+        h = self.history
+        u_nodes = h.u_nodes if model.reference is None else h.u_nodes - model.reference
+        tab, cells = model.tabulation, model.slave.cells
+        nodes = np.unique(cells)
+        back = np.asarray(self.obstacle.displacement) - h.obstacle_displacement
+        normals = np.zeros_like(u_nodes)
+        normals[nodes] = self.obstacle.gradient(model.slave.x[nodes] + u_nodes[nodes] + back)
+        projectors = _projectors(normals)
+        blocks = np.einsum("cq,cqa,cqb->cab", tab.weights, model.Mbar, tab.phi)
+        nc, nd = cells.shape
+        cols = model.node_dofs(cells).reshape(nc, nd * self.slave.gdim)
+        mass = self.slave.layout.sum_at_functions(cells, blocks.sum(axis=2))
+        return _SlipOperator(self._assemble(model, cells, cols, blocks, projectors),
+                             projectors, mass[:, None, None] * projectors)
+
+    # -- evaluation --------------------------------------------------------------------
+    def evaluate(self, model, state: ContactState, u, active: FloatArray,
+                 mask: Optional[PETSc.Vec]) -> FrictionState:
+        """Friction at the displacement Function ``u`` with the normal state
+        ``state`` and ``active`` (0/1 per node, the nodes stiffened normally)."""
+        operator = self._slip_operator(model)
+        h = self.history
+        du = u.x.petsc_vec.copy()
+        du.axpy(-1.0, h.u)
+        Gdu = operator.G_T.createVecLeft()
+        operator.G_T.mult(du, Gdu)
+        gdim = self.slave.gdim
+        slip = model.dofs.to_local(Gdu).reshape(-1, gdim)
+        for v in (du, Gdu):
+            v.destroy()
+        if operator.obstacle_weights is not None:
+            motion = np.asarray(self.obstacle.displacement) - h.obstacle_displacement
+            slip -= operator.obstacle_weights @ motion
+        weights = state.weights * (self.penalty / self.normal_law.penalty)
+        history = np.einsum("aik,ak->ai", operator.projectors, h.forces)
+        trial = history + weights[:, None] * slip
+        mapping = self.law.return_mapping(trial, state.force, weights, active > 0)
+        G_T = operator.G_T.copy()
+        if mask is not None:
+            G_T.diagonalScale(None, mask)
+        f = G_T.createVecLeft()
+        f.array[:] = mapping.force[: self.slave.layout.num_owned].ravel()
+        residual = G_T.createVecRight()
+        G_T.multTranspose(f, residual)
+        f.destroy()
+        return FrictionState(slip, mapping, G_T, weights, history, residual)
+
+    def _node_blocks(self, model, values: FloatArray, columns: str) -> PETSc.Mat:
+        """A matrix of one block per owned slave-surface node: (gdim × gdim)
+        on the dofs (``columns="dofs"``) or (gdim × 1) on the node
+        (``columns="nodes"``)."""
+        layout, gdim = self.slave.layout, self.slave.gdim
+        nodes = np.unique(self.slave.cells)
+        nodes = nodes[nodes < layout.num_owned]
+        rows = nodes[:, None] * gdim + np.arange(gdim)
+        if columns == "dofs":
+            return assemble_blocks(model.dofs, rows, model.dofs, model.node_dofs(nodes),
+                                   values[nodes])
+        return assemble_blocks(model.dofs, rows, layout, layout.global_indices[nodes][:, None],
+                               values[nodes][:, :, None])
+
+    def jacobian(self, model, state: ContactState, friction: FrictionState,
+                 active: FloatArray) -> PETSc.Mat:
+        """``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ωH G)`` at ``friction``."""
+        mapping = friction.mapping
+        states = mapping.state
+        # the exact slip tangent (0 along t in 2D) lets a slipping node's
+        # direction flip in one Newton step across the tiny stick range μp/ε_T,
+        # and the states then cycled (block on a slope: every local kind, 18
+        # iterations then cut-backs); the secant along t is taken until the
+        # states repeat on every rank, then Newton is exact again
+        settled = self.comm.allreduce(bool(self._jacobian_states is not None
+                                           and np.array_equal(states, self._jacobian_states)),
+                                      op=MPI.LAND)
+        self._jacobian_states = states.copy()
+        C = self._node_blocks(model, mapping.tangent if settled else mapping.secant_tangent(),
+                              "dofs")
+        B = self._node_blocks(model, mapping.normal_tangent
+                              * (state.weights * active)[:, None], "nodes")
+        J = C.matMult(friction.G_T)
+        J.axpy(1.0, B.matMult(state.G), structure=DIFFERENT)
+        K = transpose_mat_mult(friction.G_T, J)
+        for m in (C, B, J):
+            m.destroy()
+        return K
+
+    def pattern(self, model, state: ContactState, friction: FrictionState) -> PETSc.Mat:
+        """Every entry :meth:`jacobian` may have (stick and slip at every node)."""
+        gdim = self.slave.gdim
+        n = self.slave.layout.size_local
+        C = self._node_blocks(model, np.ones((n, gdim, gdim)), "dofs")
+        B = self._node_blocks(model, np.ones((n, gdim)), "nodes")
+        J = C.matMult(friction.G_T)
+        J.axpy(1.0, B.matMult(state.G), structure=DIFFERENT)
+        return transpose_mat_mult(friction.G_T, J)
+
+    # -- the history -------------------------------------------------------------------
+    def accept(self, friction: FrictionState, u) -> None:
+        """Make a converged step's forces the history, add the step's
+        dissipation and record its displacement.
+
+        The dissipation of a step is the work of the friction forces on the
+        plastic slip ``Δy_p = Δy_T − (f_T − P f_T^n)/ω_T``, integrated by the
+        trapezoidal rule: ``Σ_A ½(P f_T^n + f_T)_A · Δy_p,A``. With the work of
+        the loads integrated the same way, the energy balance of a path closes
+        to the Newton tolerance (docs/FRICTION.md); it equals the return
+        mapping's ``f_T · Δy_p`` while a node slips at a constant normal force.
+        """
+        mapping = friction.mapping
+        w = friction.tangential_weights
+        elastic = np.zeros_like(mapping.force)
+        np.divide(mapping.force - friction.projected_history, w[:, None], out=elastic,
+                  where=(w > 0)[:, None])
+        plastic = np.where((mapping.state > 0)[:, None], friction.slip_increment - elastic, 0.0)
+        n = self.slave.layout.num_owned
+        mean = 0.5 * (mapping.force[:n] + friction.projected_history[:n])
+        local = float(np.einsum("ai,ai->", mean, plastic[:n]))
+        step = self.comm.allreduce(local)
+        h = self.history
+        h.forces = mapping.force.copy()
+        u.x.scatter_forward()
+        h.u.destroy()
+        h.u = u.x.petsc_vec.copy()
+        h.u_nodes = nodal_displacement(self.slave, u)
+        if self.obstacle is not None:
+            h.obstacle_displacement = np.array(self.obstacle.displacement, dtype=float)
+        h.step_dissipation = step
+        h.dissipation += step
+        h.version += 1
+        h.accepted = friction
+
+    def at_accepted_step(self, u) -> bool:
+        """Whether ``u`` is, bit for bit on every rank, the displacement of the
+        last accepted step (collective)."""
+        h = self.history
+        same = h.accepted is not None and np.array_equal(u.x.petsc_vec.array_r, h.u.array_r)
+        return bool(self.comm.allreduce(same, op=MPI.LAND))
+
+    def stored_energy(self, friction: FrictionState) -> float:
+        """``Σ_A |f_T,A|² / (2 ω_T,A)`` over all ranks: the elastic energy of
+        the tangential penalty springs."""
+        w = friction.tangential_weights
+        n = self.slave.layout.num_owned
+        energy = np.zeros(n)
+        np.divide(np.sum(friction.mapping.force[:n] ** 2, axis=1), 2 * w[:n], out=energy,
+                  where=w[:n] > 0)
+        return float(self.comm.allreduce(float(energy.sum())))
