@@ -56,7 +56,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--tangential-penalty", type=float, default=None,
-                        help="ε_T as a multiple of E/h_contact (default: ε_T = ε)")
+                        help="ε_T as a multiple of E/h_contact (default: the library's, ε/10)")
     parser.add_argument("--load-steps", type=int, default=4,
                         help="steps of the approach's first guess (4)")
     parser.add_argument("--tangential-steps", type=int, default=4,

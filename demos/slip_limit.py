@@ -49,7 +49,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_block (1e3)")
     parser.add_argument("--tangential-penalty", type=float, default=None,
-                        help="ε_T as a multiple of E/h_block (default: ε_T = ε)")
+                        help="ε_T as a multiple of E/h_block (default: the library's, ε/10)")
     parser.add_argument("--load-steps", type=int, default=4, help="steps applying G (4)")
     parser.add_argument("--push-steps", type=int, default=12, help="steps of the push (12)")
     parser.add_argument("--output", default=None, help="XDMF file for the steps")
@@ -154,14 +154,19 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
                      "ratio": float(-C[0] / C[1]) if C[1] > 0 else 0.0,
                      "stick_nodes": summary["stick_nodes"], "slip_nodes": summary["slip_nodes"],
                      "dissipation": summary["dissipation"],
-                     "newton_iterations": step.newton_iterations})
+                     "newton_iterations": step.newton_iterations,
+                     "terminal_iterations": step.terminal_iterations()})
 
     result = solver.solve(update, load_steps=args.load_steps + args.push_steps,
                           output=args.output, on_step=record)
     wall = time.perf_counter() - clock
     last = rows[-1]
+    if ratio_exact == 0:
+        error = last["ratio"]
+    else:
+        error = last["ratio"] / ratio_exact - 1
     return {"slip_ratio": last["ratio"], "slip_ratio_exact": ratio_exact,
-            "slip_ratio_error": last["ratio"] / ratio_exact - 1,
+            "slip_ratio_error": error,
             "max_ratio": max(r["ratio"] for r in rows),
             "all_slip": last["stick_nodes"] == 0 and last["slip_nodes"] > 0,
             "tan_alpha": args.tan_alpha, "mu": args.mu, "kind": args.kind,

@@ -1,0 +1,116 @@
+"""The friction demos against their analytic answers: the slip limit on an
+inclined interface and Cattaneo–Mindlin's stick zone; the same numbers on
+one rank and on all."""
+from __future__ import annotations
+
+import json
+
+import pytest
+from mpi4py import MPI
+
+from support import load_demo
+from support.scenes import LOCAL_KINDS
+
+
+@pytest.fixture
+def out(tmp_path_factory):
+    return tmp_path_factory.mktemp(f"rank{MPI.COMM_WORLD.rank}")
+
+
+#: LmLS and LmLS* when the whole interface slips from the first step on (tan α = 0.2
+#: > μ = 0.1, the block held at its top): Newton cycles between two slip patterns of
+#: the nodes where the slip changes direction, at every load increment down to 1/32
+#: (the dual kinds, whose nodal slips do not couple neighbours, converge)
+CYCLES = pytest.mark.xfail(reason="Newton cycles: LmLS(*) with full slip from the start",
+                           strict=True, raises=Exception)
+SLIP_CASES = ([("0.2", "0.3", kind, "initial") for kind in LOCAL_KINDS]
+              + [("0.0", "0.3", "LmLS", "initial"), ("0.5", "0.5", "LmLS*", "initial"),
+                 ("0.5", "0.3", "LcLS*", "initial"), ("0.2", "0.1", "LcLS", "initial"),
+                 ("0.2", "0.3", "LcLS*", "previous"), ("0.0", "0.3", "LmLS", "previous"),
+                 pytest.param("0.2", "0.1", "LmLS*", "initial", marks=CYCLES),
+                 pytest.param("0.2", "0.1", "LmLS", "previous", marks=CYCLES),
+                 ("0.5", "0.3", "LmLS", "initial")])
+
+
+@pytest.mark.parametrize("tan_alpha, mu, kind, configuration", SLIP_CASES)
+def test_the_block_slides_at_coulombs_ratio(tan_alpha, mu, kind, configuration):
+    """F/G at full slip is (tan α + μ)/(1 − μ tan α) to round-off in the
+    initial configuration: the mortar forces' tangential and normal resultants
+    are exactly in the ratio μ. The previous configuration slides along the
+    deformed interface, tilted by the bodies' strain (about 2e-3 rad here):
+    0.5 … 1.2% off the undeformed slope's ratio. Each step ends quadratically
+    (at most 3 iterations below 1e-3 of its force)."""
+    demo = load_demo("slip_limit")
+    figures = demo.run(demo.parse_args(["--tan-alpha", tan_alpha, "--mu", mu, "--kind", kind,
+                                        "--basis-configuration", configuration,
+                                        "--push-steps", "6"]), MPI.COMM_WORLD)
+    assert figures["all_slip"]
+    if configuration == "initial":
+        assert abs(figures["slip_ratio_error"]) < 1e-9
+        assert figures["max_ratio"] <= figures["slip_ratio_exact"] * (1 + 1e-9)
+    else:
+        assert 1e-3 < abs(figures["slip_ratio_error"]) < 0.02
+    assert all(0 <= row["terminal_iterations"] <= 3 for row in figures["steps"])
+
+
+def test_the_slip_limit_demo_writes_its_json(out):
+    demo = load_demo("slip_limit")
+    figures = demo.main(["--push-steps", "4", "--json", str(out / "slip.json")])
+    if MPI.COMM_WORLD.rank == 0:
+        written = json.loads((out / "slip.json").read_text())
+        assert written["slip_ratio"] == figures["slip_ratio"]
+        assert {"slip_ratio", "slip_ratio_exact"} <= set(written)
+
+
+def test_cattaneo_mindlin_stick_zone_converges_with_the_mesh(out):
+    """c/a = (1 − Q/μP)^½ for two equal cylinders; the stick zone within half
+    an element of the analytic one, and the tangential traction's L2 error
+    falling with h (4.5% → 3.3% for LcLS* at refine 0.5 → 1)."""
+    demo = load_demo("cattaneo_mindlin")
+    rows = []
+    for refine in ("0.5", "1"):
+        f = demo.main(["--refine", refine, "--json", str(out / f"cm{refine}.json")])
+        rows.append(f)
+        assert abs(f["c"] - f["c_analytic"]) < 0.5 * f["h_contact"] * 1.1
+        assert abs(f["a_error"]) < 0.01
+        assert f["slip_nodes"] > 0 and f["stick_nodes"] > 0
+        assert f["P"] == pytest.approx(0.01, rel=1e-4)
+        assert f["Q"] == pytest.approx(0.0015, rel=1e-4)
+    assert rows[1]["q_l2_error"] < rows[0]["q_l2_error"] < 0.05
+    if MPI.COMM_WORLD.rank == 0:
+        written = json.loads((out / "cm1.json").read_text())
+        for key in ("a", "c", "c_analytic", "q_l2_error", "dofs", "wall_time", "a_hertz"):
+            assert key in written
+
+
+@pytest.mark.parametrize("kind", ["LmLS", "LmLS*", "LcLS"])
+def test_cattaneo_mindlin_every_local_kind(kind):
+    demo = load_demo("cattaneo_mindlin")
+    f = demo.run(demo.parse_args(["--refine", "0.5", "--kind", kind]), MPI.COMM_WORLD)
+    assert abs(f["c_error"]) < 0.06
+    assert f["q_l2_error"] < 0.07
+
+
+def test_slip_limit_same_on_one_and_all_ranks():
+    demo = load_demo("slip_limit")
+    args = demo.parse_args(["--tan-alpha", "0.2", "--mu", "0.3", "--push-steps", "4"])
+    rows = [demo.run(args, comm)["steps"] for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)]
+    for a, b in zip(*rows):
+        assert a["F"] == pytest.approx(b["F"], rel=1e-8, abs=1e-14)
+        assert a["G"] == pytest.approx(b["G"], rel=1e-8)
+        assert (a["stick_nodes"], a["slip_nodes"]) == (b["stick_nodes"], b["slip_nodes"])
+        assert a["dissipation"] == pytest.approx(b["dissipation"], rel=1e-6, abs=1e-16)
+
+
+def test_cattaneo_mindlin_same_on_one_and_all_ranks():
+    demo = load_demo("cattaneo_mindlin")
+    args = demo.parse_args(["--refine", "0.25"])
+    runs = [demo.run(args, comm) for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)]
+    for key in ("a", "c", "q_l2_error", "P", "Q", "stick_nodes", "slip_nodes"):
+        assert runs[0][key] == pytest.approx(runs[1][key], rel=1e-7), key
+
+
+def test_the_sphere_says_it_needs_3d():
+    demo = load_demo("cattaneo_mindlin")
+    with pytest.raises(NotImplementedError, match="3D"):
+        demo.run(demo.parse_args(["--geometry", "sphere"]), MPI.COMM_SELF)
