@@ -4,9 +4,11 @@ A neo-Hookean slab (9 × 3 in 2D, 9 × 4 × 3 in 3D; E = 1, ν = 0.3, bottom
 fixed) and a half-cylindrical die (a half ring of outer radius 3 and
 thickness 0.2, 5.2 wide in 3D), 1000 times stiffer, both meshed. The die's
 two flat end faces are driven: down by 1.4, then along the slab by 4.0 (and,
-with ``return_slide``, back to where the slide began). Frictionless; the slab's
-top is the slave surface, the die's outer face the master; everything on the
-current configuration. The paper's ν = 0.499 locks P1 elements, hence ν = 0.3.
+with ``return_slide``, back to where the slide began). Frictionless by default
+(on the current configuration), with Coulomb friction (``--mu 0.3``, the
+paper's) on the previous one, which friction needs; the slab's top is the
+slave surface, the die's outer face the master. The paper's ν = 0.499 locks P1
+elements, hence ν = 0.3.
 
 The die's reaction (the force its driven faces need) is the bulk residual
 summed over those faces' dofs: at equilibrium it equals the contact force on
@@ -23,10 +25,10 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar import (ContactDivergenceError, ContactTerm, LoadPathSolver,
-                            NonlinearContactProblem)
+from dolfinx_mortar import (ContactDivergenceError, ContactTerm, CoulombFriction,
+                            LoadPathSolver, NonlinearContactProblem)
 from demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
-from demo_support.laws import neo_hookean_residual
+from demo_support.laws import neo_hookean_energy, neo_hookean_residual
 from dolfinx_mortar.io.output import save_figure, write_csv, write_json
 
 #: facet tags
@@ -57,6 +59,13 @@ def parse_args(doc: str, dim: int, argv=None) -> argparse.Namespace:
                         help="element size of the die (default: the slab's, at most the "
                              "die's thickness)")
     parser.add_argument("--kind", default="LmLS*", help="mortar basis kind (LmLS*)")
+    parser.add_argument("--mu", type=float, default=0.0,
+                        help="Coulomb friction coefficient (0: frictionless; Puso and "
+                             "Laursen's is 0.3)")
+    parser.add_argument("--basis-configuration", default=None,
+                        choices=("initial", "previous", "current"),
+                        help="the bases' configuration (default: current, or previous with "
+                             "friction, which the current one does not support)")
     parser.add_argument("--penalty", type=float, default=1e2,
                         help="penalty ε as a multiple of E/h of the slab (1e2)")
     parser.add_argument("--press-steps", type=int, default=10, help="steps pressing (10)")
@@ -77,6 +86,8 @@ def parse_args(doc: str, dim: int, argv=None) -> argparse.Namespace:
     if args.slide_steps is None:
         args.slide_steps = int(np.ceil(4 * SLIDE / args.h - 1e-9))
     args.dim = dim
+    if args.basis_configuration is None:
+        args.basis_configuration = "previous" if args.mu > 0 else "current"
     return args
 
 
@@ -206,7 +217,8 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
            fem.dirichletbc(drive, ends, V)]
     contact = ContactTerm(u, facet_tags, SLAB_TOP, master_tag=DIE_OUTER, kind=args.kind,
                           penalty=args.penalty * args.E / args.h,
-                          basis_configuration="current")
+                          basis_configuration=args.basis_configuration,
+                          friction=CoulombFriction(args.mu) if args.mu > 0 else None)
     residual = neo_hookean_residual(u, E, args.nu)
     problem = NonlinearContactProblem(residual, u, contact, bcs)
     motion, t_press, t_forward, total = die_motion(args)
@@ -219,6 +231,8 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     owned = ends[ends < V.dofmap.index_map.size_local]
     rows: list[dict] = []
     pressed: dict = {}
+    # the work of the die's drive, by the trapezoidal rule over the steps
+    drive_work = {"work": 0.0, "force": np.zeros(dim), "at": np.zeros(dim)}
 
     def reaction() -> np.ndarray:
         """Σ of the bulk residual over the die's driven dofs (all ranks)."""
@@ -236,6 +250,9 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
             "slide" if t <= t_forward * (1 + 1e-12) else "return")
         if phase == "press":
             pressed["u"] = u.x.array.copy()
+        at = np.array([x] + [0.0] * (dim - 2) + [z])
+        drive_work["work"] += 0.5 * float((force + drive_work["force"]) @ (at - drive_work["at"]))
+        drive_work["force"], drive_work["at"] = force, at
         # the force the drive applies to the die: down while it presses (reported
         # as a positive pressing force) and along the slab while it slides
         rows.append({"step": len(rows) + 1, "t": t, "phase": phase, "die_x": START_X + x,
@@ -244,6 +261,8 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
                      "active_nodes": step.active_nodes,
                      "newton_iterations": step.newton_iterations,
                      "terminal_iterations": step.terminal_iterations(),
+                     "drive_work": drive_work["work"],
+                     "dissipation": contact.results.dissipation(),
                      "residuals": step.phases})
 
     options = {"snes_linesearch_type": args.linesearch} if args.linesearch else None
@@ -265,8 +284,20 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
         scale = comm.allreduce(float(np.max(np.abs(pressed["u"][:n]), initial=0.0)),
                                op=MPI.MAX)
         figures["return_difference"] = difference / scale
+    if args.basis_configuration != "current":
+        # the die's work against what the bodies store and friction dissipates; the
+        # trapezoidal rule on a nonlinear bulk leaves an error of the steps' order
+        bulk_energy = comm.allreduce(fem.assemble_scalar(fem.form(
+            neo_hookean_energy(u, E, args.nu))))
+        stored = bulk_energy + contact.results.stored_energy()
+        dissipation = contact.results.dissipation()
+        figures.update({"dissipation": dissipation, "drive_work": drive_work["work"],
+                        "stored_energy": stored,
+                        "energy_balance": (drive_work["work"] - stored - dissipation)
+                        / drive_work["work"]})
     figures.update({
         "dim": dim, "kind": args.kind, "penalty": args.penalty, "h": args.h,
+        "mu": args.mu, "basis_configuration": args.basis_configuration,
         "h_die": args.h_die, "dofs": int(dofs), "load_steps": len(result.steps),
         "requested_steps": total, "newton_iterations": result.newton_iterations,
         "max_newton_per_step": max(r["newton_iterations"] for r in rows),
@@ -348,6 +379,11 @@ def report(f: dict) -> None:
               f"ripple about its trend {f['normal_ripple']:.3e}; tangential/normal mean "
               f"{f['tangential_mean']:+.3e}, max-min {f['tangential_oscillation']:.3e}, "
               f"ripple {f['tangential_ripple']:.3e}")
+    if "dissipation" in f:
+        print(f"  μ = {f['mu']:g} ({f['basis_configuration']}): work of the die "
+              f"{f['drive_work']:.6g}, frictional dissipation {f['dissipation']:.6g} "
+              f"({100 * f['dissipation'] / f['drive_work']:.1f}% of it), stored "
+              f"{f['stored_energy']:.6g}; unbalanced {f['energy_balance']:+.2e} of the work")
     if "return_difference" in f:
         print(f"  back at the start: max |u - u_pressed| / max |u_pressed| = "
               f"{f['return_difference']:.2e}")

@@ -19,6 +19,12 @@ from support.scenes import LOCAL_KINDS, block_on_plane
 TOLERANCE = 1e-6
 
 
+def friction(penalty: float) -> CoulombFriction:
+    """μ = 0.3 with ε_T = ε: the scenes' shear then slips at the ends and
+    sticks in the middle (the tangent does not depend on the choice)."""
+    return CoulombFriction(0.3, tangential_penalty=penalty)
+
+
 def count_states(problem) -> tuple[int, int]:
     """Sticking and slipping slave nodes on all ranks at the present u; checks
     that no node sits on the cone, where central differences straddle the kink
@@ -66,7 +72,7 @@ def block(obstacle, kind="LcLS*", scaling="consistent", axisymmetric=False,
     problem = ContactProblem(V, tags, 1, obstacle=obstacle, E=1.0, nu=0.3, kind=kind,
                              scaling=scaling, penalty=50.0, tractions={2: [0.002, -0.01]},
                              axisymmetric=axisymmetric, basis_configuration=configuration,
-                             friction=CoulombFriction(0.3))
+                             friction=friction(50.0))
     problem.set_load(1.0)
     return problem
 
@@ -111,7 +117,7 @@ def box(obstacle, kind: str) -> ContactProblem:
     V = fem.functionspace(domain, ("Lagrange", 1, (3,)))
     problem = ContactProblem(V, tags, 1, obstacle=obstacle, E=1.0, nu=0.3, kind=kind,
                              penalty=50.0, tractions={2: [0.002, 0.0, -0.01]},
-                             friction=CoulombFriction(0.3))
+                             friction=friction(50.0))
     problem.set_load(1.0)
     return problem
 
@@ -144,7 +150,7 @@ def two_blocks(dim: int, kind: str, configuration: str) -> tuple[ContactProblem,
     problem = ContactProblem(V, tags, demo.LOWER_TOP, master_tag=demo.UPPER_BOTTOM, E=1.0,
                              nu=0.3, kind=kind, penalty=1e3, basis_configuration=configuration,
                              fixed={demo.BOTTOM: {k: 0.0 for k in range(dim)}},
-                             tractions={demo.TOP: load}, friction=CoulombFriction(0.3))
+                             tractions={demo.TOP: load}, friction=friction(1e3))
     problem.set_load(1.0)
     tdim = domain.topology.dim
     cells = np.arange(domain.topology.index_map(tdim).size_local, dtype=np.int32)

@@ -114,3 +114,19 @@ def test_the_sphere_says_it_needs_3d():
     demo = load_demo("cattaneo_mindlin")
     with pytest.raises(NotImplementedError, match="3D"):
         demo.run(demo.parse_args(["--geometry", "sphere"]), MPI.COMM_SELF)
+
+
+def test_frictional_ironing_2d_drags_the_die_and_dissipates():
+    """Puso and Laursen's ironing with μ = 0.3 (previous configuration): the
+    steady tangential reaction is μ plus the slab's ploughing (frictionless on
+    the same configuration: 0.02 of the normal), friction dissipates half the
+    die's work, and what is left is stored in the bodies up to the frozen
+    configuration's own imbalance (frictionless: 13%)."""
+    demo = load_demo("ironing2d")
+    f = demo.main(["--mu", "0.3", "--quiet"])
+    assert 0.3 < f["tangential_mean"] < 0.4
+    assert 0.4 < f["dissipation"] / f["drive_work"] < 0.7
+    assert abs(f["energy_balance"]) < 0.05
+    frictionless = demo.main(["--basis-configuration", "previous", "--quiet"])
+    assert abs(frictionless["tangential_mean"]) < 0.05
+    assert f["normal_mean"] == pytest.approx(frictionless["normal_mean"], rel=0.05)
