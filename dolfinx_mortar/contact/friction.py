@@ -283,8 +283,8 @@ class Friction:
                                            and np.array_equal(states, self._jacobian_states)),
                                       op=MPI.LAND)
         self._jacobian_states = states.copy()
-        C = self._node_blocks(model, mapping.tangent if settled else mapping.secant_tangent(),
-                              "dofs")
+        tangent = mapping.tangent if settled else mapping.secant_tangent()
+        C = self._node_blocks(model, tangent, "dofs")
         B = self._node_blocks(model, mapping.normal_tangent
                               * (state.weights * active)[:, None], "nodes")
         J = C.matMult(friction.G_T)

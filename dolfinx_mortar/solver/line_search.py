@@ -162,10 +162,13 @@ class FullStepFirst:
 
 def library_line_search(problem: "NonlinearContactProblem", snes: PETSc.SNES) -> FullStepFirst:
     """The library's line search for ``problem``, attached to ``snes``: it shortens
-    steps on the current surface and, for a bulk law nonlinear in u, on frozen
-    surfaces too (:meth:`LoadPathSolver.shortens_frozen_steps
-    <dolfinx_mortar.solver.load_path.LoadPathSolver.shortens_frozen_steps>`)."""
-    line_search = FullStepFirst(problem, snes,
-                                shorten=problem.current or not problem.bulk_is_linear)
+    steps on the current surface and, for a bulk law nonlinear in u or with
+    friction, on frozen surfaces too (:meth:`LoadPathSolver.shortens_frozen_steps
+    <dolfinx_mortar.solver.load_path.LoadPathSolver.shortens_frozen_steps>`).
+    Friction needs it: a slipping node at the contact edge whose direction
+    turns had full steps throw it from side to side (two pressed cylinders,
+    Newton cycling at 2e-3 of the force)."""
+    line_search = FullStepFirst(problem, snes, shorten=(problem.current or problem.frictional
+                                                        or not problem.bulk_is_linear))
     line_search.attach()
     return line_search

@@ -233,6 +233,11 @@ class NonlinearContactProblem:
         return any(term.configuration.follows_u for term in self.contacts)
 
     @property
+    def frictional(self) -> bool:
+        """Whether a contact term has friction."""
+        return any(term.friction is not None for term in self.contacts)
+
+    @property
     def num_dofs(self) -> int:
         V = self.u.function_space
         return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
