@@ -37,6 +37,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact.friction_law import CoulombFriction, ReturnMapping
 from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
+from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import is_global, kind_name
@@ -157,11 +158,14 @@ class Friction:
         The contact term's options (checked here for what friction supports).
     u
         The displacement Function (its present value starts the history).
+    slave
+        The slave surface (:class:`~dolfinx_mortar.surfaces.lagrange.LagrangeSurface`).
     obstacle
         The term's rigid obstacle, or None.
     """
 
-    def __init__(self, law: CoulombFriction, options: ContactOptions, u, slave, obstacle=None):
+    def __init__(self, law: CoulombFriction, options: ContactOptions, u, slave,
+                 obstacle: Optional[RigidObstacle] = None):
         check_friction_options(options)
         self.law = law
         self.normal_law = options.law
@@ -178,16 +182,21 @@ class Friction:
         #: the stick/slip states of the last Jacobian (the exact slip tangent
         #: once they repeat)
         self._jacobian_states: Optional[npt.NDArray[np.int8]] = None
-        self._operator_key: tuple = ()
+        #: the model and the step the slip operator was made for
+        self._operator_for: tuple = (None, -1)
 
     # -- the slip operator of a step ---------------------------------------------------
     def _slip_operator(self, model) -> _SlipOperator:
-        key = (model, self.history.version if isinstance(model, ObstacleGap) else -1)
-        if self._operator is None or self._operator_key[0] is not key[0] \
-                or self._operator_key[1] != key[1]:
-            self._operator = (self._obstacle_operator(model) if isinstance(model, ObstacleGap)
+        """The slip operator of the present step: made again for a new model
+        and, against an obstacle (whose tangent planes are those where the step
+        starts), for every new step."""
+        obstacle = isinstance(model, ObstacleGap)
+        step = self.history.version if obstacle else -1
+        made_for, made_at = self._operator_for
+        if self._operator is None or made_for is not model or made_at != step:
+            self._operator = (self._obstacle_operator(model) if obstacle
                               else self._mortar_operator(model))
-            self._operator_key = key
+            self._operator_for = (model, step)
         return self._operator
 
     def _assemble(self, model, cells, cols, blocks, projectors) -> PETSc.Mat:
