@@ -49,8 +49,9 @@ FloatArray = npt.NDArray[np.float64]
 DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 
 
-def check_friction_options(options: ContactOptions) -> None:
-    """NotImplementedError naming a combination friction does not support, and why."""
+def check_friction_options(options: ContactOptions, follows_u: bool) -> None:
+    """NotImplementedError naming a combination friction does not support, and why
+    (``follows_u``: the bases are on the current surface)."""
     if is_global(options.kind):
         raise NotImplementedError(
             f"friction with {kind_name(options.kind)}: the tangential forces of the global "
@@ -59,7 +60,7 @@ def check_friction_options(options: ContactOptions) -> None:
     if options.law.pointwise:
         raise NotImplementedError("friction with active_set='pointwise': the Coulomb cone is "
                                   "set by the nodal normal forces; use active_set='nodal'")
-    if options.basis_configuration == "current":
+    if follows_u:
         raise NotImplementedError(
             "friction with basis_configuration='current': the slip on the current surface "
             "needs the derivatives of its tangent planes and mortar integrals in the "
@@ -162,11 +163,13 @@ class Friction:
         The slave surface (:class:`~dolfinx_mortar.surfaces.lagrange.LagrangeSurface`).
     obstacle
         The term's rigid obstacle, or None.
+    follows_u
+        The term's bases are on the current surface (refused).
     """
 
     def __init__(self, law: CoulombFriction, options: ContactOptions, u, slave,
-                 obstacle: Optional[RigidObstacle] = None):
-        check_friction_options(options)
+                 obstacle: Optional[RigidObstacle] = None, follows_u: bool = False):
+        check_friction_options(options, follows_u)
         self.law = law
         self.normal_law = options.law
         #: ε_T

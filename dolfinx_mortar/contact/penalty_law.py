@@ -124,6 +124,11 @@ class PenaltyLaw:
         return np.divide(force, W, out=np.zeros_like(W), where=W > 0)
 
     @staticmethod
+    def potential(weights: FloatArray, gaps: FloatArray) -> FloatArray:
+        """``(ω_A/2)⟨y_A⟩²`` per node: the energy of the penalty springs."""
+        return 0.5 * weights * positive_part(gaps) ** 2
+
+    @staticmethod
     def active(gaps: FloatArray) -> npt.NDArray[np.bool_]:
         """``H(y)`` with the generalized derivative of ⟨·⟩ at 0 taken as 1, so
         that touching nodes stiffen without pushing."""

@@ -187,7 +187,7 @@ class ContactResults:
             raise NotImplementedError("the stored energy is that of the nodal active set on "
                                       "frozen bases ('initial' or 'previous')")
         n = self.term.slave.layout.num_owned
-        normal = 0.5 * np.sum((state.weights * np.maximum(state.gaps, 0.0) ** 2)[:n])
+        normal = np.sum(self.term.options.law.potential(state.weights, state.gaps)[:n])
         energy = float(self.term.mesh.comm.allreduce(float(normal)))
         if self.term.friction is not None:
             energy += self.term.friction.stored_energy(state.friction)

@@ -149,8 +149,8 @@ class ContactTerm:
         self.checks = RangeChecks(self)
         #: Coulomb friction and its history (None: frictionless)
         self.friction: Optional[Friction] = (
-            Friction(friction, options, u, self.slave, obstacle) if friction is not None
-            else None)
+            Friction(friction, options, u, self.slave, obstacle,
+                     self.configuration.follows_u) if friction is not None else None)
         self.model: GapModel = self._timed_build(self.configuration.build, options)
         self.checks.warn_deep_initial_penetration()
         self.checks.warn_if_no_master_is_in_reach(self.configuration.segmentation(self.model))

@@ -80,6 +80,18 @@ class EquilibriumTest:
         self.norms: list[float] = []
         #: why the last solve was stopped by this test without convergence
         self.cause: Optional[str] = None
+        #: the largest out-of-balance force a step of the path started with
+        self.force_scale = 0.0
+
+    def step_reference(self, out_of_balance: float) -> float:
+        """The force F of a load step that starts ``out_of_balance``: that force,
+        or for a step that changes nothing (a hold, Q = 0 after P), which starts
+        at the round-off floor of the forces met so far, their scale. Its own
+        round-off residual is no scale to reduce (such a step failed at stol)."""
+        if out_of_balance <= self.floor_rtol * self.force_scale:
+            return self.force_scale
+        self.force_scale = max(self.force_scale, out_of_balance)
+        return out_of_balance
 
     def start(self, reference: Optional[float]) -> None:
         """A new Newton solve; ``reference`` is the force ``F`` of ``‖R‖ ≤ rtol·F``

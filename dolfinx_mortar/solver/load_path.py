@@ -83,7 +83,6 @@ class LoadPathSolver:
         #: the line search of the last :meth:`create_snes` (None where the user
         #: chose one: :meth:`library_line_search`)
         self.line_search: Optional[FullStepFirst] = None
-        self._force_scale = 0.0
 
     @property
     def contacts(self):
@@ -213,8 +212,7 @@ class LoadPathSolver:
         if predictor not in ("none", "linear"):
             raise ValueError(f"predictor must be 'none' or 'linear', not {predictor!r}")
         stepper = LoadStepper(load_steps, max_cuts)
-        # the largest out-of-balance force a step of this solve started with
-        self._force_scale = 0.0
+        self.equilibrium.force_scale = 0.0
         u = self.problem.u
         if not np.all(np.isfinite(u.x.array)):
             raise ValueError("the displacement contains NaN or infinite values")
@@ -325,13 +323,7 @@ class LoadPathSolver:
         iterations = linear = 0
         b = self.problem.vector()
         self.problem.F(x, b)
-        reference = b.norm()
-        if reference <= self.equilibrium.floor_rtol * self._force_scale:
-            # a step that changes nothing (a hold, Q = 0 after P): the start is
-            # at the round-off floor of the forces met so far, and its own
-            # round-off residual is no scale to reduce (it failed at stol)
-            reference = self._force_scale
-        self._force_scale = max(self._force_scale, reference)
+        reference = self.equilibrium.step_reference(b.norm())
         self.equilibrium.start(reference)
         if increment is not None:
             x.axpy(1.0, increment)
