@@ -1,27 +1,40 @@
-"""Cattaneo–Mindlin partial slip: two equal cylinders pressed together, then sheared.
+"""Cattaneo–Mindlin partial slip: two equal cylinders or spheres pressed together, then sheared.
 
-Two elastically similar bodies (plane strain): the upper half of a cylinder of
-radius R on the lower half of an equal one (fixed at its flat bottom), so
-that the normal and tangential problems decouple. The normal line load P
-(per unit length) is applied first as a uniform traction on the upper flat
-edge, then a tangential line load Q < μP the same way while P is held. The
-contact stays the Hertz strip |x| < a, and a central stick zone |x| < c
-remains with (Cattaneo 1938, Mindlin 1949; Johnson, Contact Mechanics §7.1)
+Two elastically similar bodies, so that the normal and tangential problems
+decouple:
 
-    c/a = (1 − Q/(μP))^{1/2},
-    q(x) = μ p0 (√(1 − x²/a²) − (c/a) √(1 − x²/c²))  for |x| < c,
-    q(x) = μ p0 √(1 − x²/a²)                          for c ≤ |x| ≤ a,
+- ``--geometry cylinder`` (plane strain): the upper half of a cylinder of
+  radius R on the lower half of an equal one, loads per unit length;
+- ``--geometry sphere`` (3D): two equal hemispheres, modelled as the half
+  y ≥ 0 (the lateral load along x keeps that symmetry), loads on the whole
+  sphere.
 
-with the Hertz a = √(4PR*/(πE*)), p0 = 2P/(πa), E* = E/(2(1 − ν²)), R* = R/2. The demo
-reports a (the Hertz profile fitted to the pressures), c (midway between the
-outermost sticking node and the first slipping one on each side) and the L2
-error of the tangential traction against q(x) over the contact strip.
+The lower body is fixed at its flat bottom. A rigid holder moves the upper
+flat face without turning it (a body loaded by forces alone would roll):
+down until the contact carries the normal load P, then sideways until it
+carries Q < μP while P is held. The contact stays Hertz's (half-width or
+radius a), and a central stick zone of size c remains, with (Cattaneo 1938,
+Mindlin 1949; Johnson, Contact Mechanics §7.1–7.2)
 
-The mesh is graded to a/(40·refine) at the contact. The holder's approach δ
-and shift s are found by secant steps on the contact resultant (to 1e-5 of
-P and Q); s only grows, so that no slip reverses.
+    c/a = (1 − Q/(μP))^{1/2} (cylinder),   (1 − Q/(μP))^{1/3} (sphere),
+    q(r) = μ p0 (√(1 − r²/a²) − (c/a) √(1 − r²/c²))  for r < c,
+    q(r) = μ p0 √(1 − r²/a²)                          for c ≤ r ≤ a.
 
-    python3 demos/cattaneo_mindlin.py --tangential 0.005 --mu 0.3 --json results/cm.json
+Hertz with R* = R/2 and E* = E/(2(1 − ν²)): a = √(4PR*/(πE*)),
+p0 = 2P/(πa) for the cylinders; a = (3PR*/(4E*))^{1/3}, p0 = 3P/(2πa²) for the
+spheres. The demo reports a (the Hertz profile fitted to the pressures), c,
+and the L2 error of the tangential traction against q over the contact. c is
+read from the nodes: for the cylinder midway between the outermost sticking
+node and the next one on each side, and for the sphere from the sticking
+nodes' area, πc² = Σ W_A (doubled for the half model).
+
+The mesh is graded to a/(40·refine) at the contact for the cylinder, and to
+a/(8·refine) for the sphere. The holder's approach δ and shift s are found by
+secant steps on the contact resultant (to 1e-5 of P and Q). s only grows, so
+that no slip reverses.
+
+    python3 demos/cattaneo_mindlin.py --tangential 0.0015 --mu 0.3 --json results/cm.json
+    python3 demos/cattaneo_mindlin.py --geometry sphere --json results/cm_sphere.json
 """
 from __future__ import annotations
 
@@ -34,25 +47,28 @@ from mpi4py import MPI
 
 from demo_support.cli import parse_args_and_petsc_options, solver_demo_parser
 from demo_support.hertz_fit import fit_hertz_profile
-from demo_support.hertz_meshes import FIXED, LOAD, MASTER, SLAVE, half_disk_pair_mesh
+from demo_support.hertz_meshes import (FIXED, LOAD, MASTER, SLAVE, SYMMETRY_Y,
+                                      half_disk_pair_mesh, half_sphere_pair_mesh)
 from dolfinx_mortar.io.output import write_json
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser = solver_demo_parser(__doc__)
     parser.add_argument("--geometry", default="cylinder", choices=("cylinder", "sphere"),
-                        help="cylinder (plane strain); sphere needs a 3D model (not yet)")
+                        help="two cylinders (plane strain) or two spheres (3D half model)")
     parser.add_argument("--radius", type=float, default=1.0, help="radius R (1)")
-    parser.add_argument("--force", type=float, default=0.01,
-                        help="normal line load P per unit length (0.01)")
-    parser.add_argument("--tangential", type=float, default=0.0015,
-                        help="tangential line load Q per unit length, below μP (0.0015)")
+    parser.add_argument("--force", type=float, default=None,
+                        help="normal load P: per unit length for the cylinder (0.01), on the "
+                             "whole sphere (0.0015); a ≈ 0.1 R")
+    parser.add_argument("--tangential", type=float, default=None,
+                        help="tangential load Q, below μP (default μP/2)")
     parser.add_argument("--mu", type=float, default=0.3, help="friction coefficient μ (0.3)")
     parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
     parser.add_argument("--basis-configuration", default="initial",
                         choices=("initial", "previous", "current"))
     parser.add_argument("--refine", type=float, default=1.0,
-                        help="mesh density factor: contact size a/(40·refine) (1)")
+                        help="mesh density factor: contact size a/(40·refine) for the "
+                             "cylinder, a/(8·refine) for the sphere (1)")
     parser.add_argument("--penalty", type=float, default=1e3,
                         help="penalty ε as a multiple of E/h_contact (1e3)")
     parser.add_argument("--tangential-penalty", type=float, default=None,
@@ -63,27 +79,40 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         help="steps of the shift's first guess (4)")
     parser.add_argument("--output", default=None, help="XDMF file for the steps")
     parser.add_argument("--json", default=None, help="write the key figures as JSON here")
-    return parse_args_and_petsc_options(parser, argv)
+    args = parse_args_and_petsc_options(parser, argv)
+    if args.force is None:
+        args.force = 0.01 if args.geometry == "cylinder" else 0.0015
+    if args.tangential is None:
+        args.tangential = 0.5 * args.mu * args.force
+    return args
 
 
 def reference(args: argparse.Namespace) -> dict:
-    """Hertz's a and p0 and Cattaneo–Mindlin's c for the arguments."""
+    """Hertz's a, p0 and approach δ, and Cattaneo–Mindlin's c for the arguments."""
     if not 0 <= args.tangential < args.mu * args.force:
         raise ValueError(f"need 0 ≤ Q < μP for partial slip, got Q = {args.tangential}, "
                          f"μP = {args.mu * args.force}")
     E_star = args.E / (2 * (1 - args.nu ** 2))
-    R_star = args.radius / 2      # two equal cylinders
-    a = np.sqrt(4 * args.force * R_star / (np.pi * E_star))
-    return {"a": a, "p0": 2 * args.force / (np.pi * a),
-            "c": a * np.sqrt(1 - args.tangential / (args.mu * args.force))}
+    R_star = args.radius / 2      # two equal bodies
+    P, ratio = args.force, 1 - args.tangential / (args.mu * args.force)
+    if args.geometry == "cylinder":
+        a = np.sqrt(4 * P * R_star / (np.pi * E_star))
+        # the approach of two cylinders (Johnson §5.6), a first guess for the holder
+        approach = P / (np.pi * E_star) * (2 * np.log(4 * args.radius / a) - 1)
+        return {"a": a, "p0": 2 * P / (np.pi * a), "c": a * ratio ** (1 / 2),
+                "approach": approach}
+    a = (3 * P * R_star / (4 * E_star)) ** (1 / 3)
+    return {"a": a, "p0": 3 * P / (2 * np.pi * a ** 2), "c": a * ratio ** (1 / 3),
+            "approach": a ** 2 / R_star}
 
 
-def tangential_traction(x: np.ndarray, ref: dict, mu: float) -> np.ndarray:
-    """Johnson's q(x) of the partial slip (positive, along −Q on the upper body)."""
+def tangential_traction(r: np.ndarray, ref: dict, mu: float) -> np.ndarray:
+    """Johnson's q at distance r from the centre of contact (positive, along −Q
+    on the upper body)."""
     a, c, p0 = ref["a"], ref["c"], ref["p0"]
-    q = mu * p0 * np.sqrt(np.maximum(0.0, 1 - (x / a) ** 2))
-    inside = np.abs(x) < c
-    q[inside] -= mu * p0 * (c / a) * np.sqrt(1 - (x[inside] / c) ** 2)
+    q = mu * p0 * np.sqrt(np.maximum(0.0, 1 - (r / a) ** 2))
+    inside = np.abs(r) < c
+    q[inside] -= mu * p0 * (c / a) * np.sqrt(1 - (r[inside] / c) ** 2)
     return q
 
 
@@ -109,9 +138,14 @@ def build(args: argparse.Namespace, ref: dict, comm: MPI.Comm):
     from dolfinx_mortar import ContactTerm, CoulombFriction
     from dolfinx_mortar.small_strain.elastic import linear_elastic_residual
     from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
-    h = ref["a"] / (40 * args.refine)
-    domain, tags = half_disk_pair_mesh(args.radius, ref["a"], h, 1, comm)
-    V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
+    sphere = args.geometry == "sphere"
+    h = ref["a"] / ((8 if sphere else 40) * args.refine)
+    if sphere:
+        domain, tags = half_sphere_pair_mesh(args.radius, ref["a"], h, comm)
+    else:
+        domain, tags = half_disk_pair_mesh(args.radius, ref["a"], h, 1, comm)
+    dim = domain.geometry.dim
+    V = fem.functionspace(domain, ("Lagrange", 1, (dim,)))
     u = fem.Function(V, name="displacement")
     eps_t = None if args.tangential_penalty is None else args.tangential_penalty * args.E / h
     contact = ContactTerm(u, tags, SLAVE, master_tag=MASTER, kind=args.kind,
@@ -120,32 +154,39 @@ def build(args: argparse.Namespace, ref: dict, comm: MPI.Comm):
                           friction=CoulombFriction(args.mu, eps_t))
     approach = fem.Constant(domain, PETSc.ScalarType(0.0))
     shift = fem.Constant(domain, PETSc.ScalarType(0.0))
-    fixed = fem.locate_dofs_topological(V, 1, tags.find(FIXED))
+    fdim = dim - 1
+    fixed = fem.locate_dofs_topological(V, fdim, tags.find(FIXED))
     top = tags.find(LOAD)
-    bcs = [fem.dirichletbc(np.zeros(2, dtype=PETSc.ScalarType), fixed, V),
-           fem.dirichletbc(shift, fem.locate_dofs_topological(V.sub(0), 1, top), V.sub(0)),
-           fem.dirichletbc(approach, fem.locate_dofs_topological(V.sub(1), 1, top), V.sub(1))]
+    vertical = V.sub(dim - 1)
+    bcs = [fem.dirichletbc(np.zeros(dim, dtype=PETSc.ScalarType), fixed, V),
+           fem.dirichletbc(shift, fem.locate_dofs_topological(V.sub(0), fdim, top), V.sub(0)),
+           fem.dirichletbc(approach, fem.locate_dofs_topological(vertical, fdim, top), vertical)]
+    if sphere:
+        plane = fem.locate_dofs_topological(V.sub(1), fdim, tags.find(SYMMETRY_Y))
+        bcs.append(fem.dirichletbc(PETSc.ScalarType(0.0), plane, V.sub(1)))
     problem = NonlinearContactProblem(linear_elastic_residual(u, args.E, args.nu), u, contact,
                                       bcs)
     return contact, problem, approach, shift, h
 
 
 class Holder:
-    """The rigid holder of the upper cylinder: it moves its flat edge by
-    (s, −δ) without turning, and finds the δ and s that make the contact
-    carry P and Q (a cylinder loaded by forces alone would roll)."""
+    """The rigid holder of the upper body: it moves its flat face by (s, −δ)
+    along x and the vertical without turning it, and finds the δ and s that
+    make the contact carry P and Q (a body loaded by forces alone would roll).
+    ``share``: the modelled share of the body (½ for the half sphere)."""
 
-    def __init__(self, contact, problem, approach, shift, steps: int):
+    def __init__(self, contact, problem, approach, shift, steps: int, share: float = 1.0):
         from dolfinx_mortar import LoadPathSolver
         self.contact, self.approach, self.shift = contact, approach, shift
+        self.share = share
         self.solver = LoadPathSolver(problem)
         self.steps = steps
         self.newton_iterations = self.load_steps = self.cut_backs = 0
 
     def forces(self) -> tuple[float, float]:
         """(P, Q) that the contact carries: the resultant on the upper body."""
-        C = self.contact.results.contact_force()
-        return float(C[1]), float(-C[0])
+        C = self.contact.results.contact_force() / self.share
+        return float(C[-1]), float(-C[0])
 
     def move(self, constant, target: float, steps: int) -> None:
         start = float(constant.value)
@@ -182,27 +223,36 @@ def results(args: argparse.Namespace, contact, ref: dict) -> dict:
     """a, c and the tangential traction's error, gathered on every rank."""
     comm = contact.mesh.comm
     slave = contact.slave
+    sphere = args.geometry == "sphere"
     state = contact.evaluate()
     n = slave.layout.num_owned
     on = np.zeros(slave.layout.size_local, dtype=bool)
     on[slave.cells] = True
     mine = np.flatnonzero(on[:n])
-    x = np.concatenate(comm.allgather(slave.x[mine, 0]))
+    # distance from the centre of contact in the contact plane
+    r = np.linalg.norm(slave.x[:, :2], axis=1) if sphere else slave.x[:, 0]
+    x = np.concatenate(comm.allgather(r[mine]))
     p = np.concatenate(comm.allgather(contact.results.nodal_pressures(state)[mine]))
-    states = np.concatenate(comm.allgather(contact.results.slip_states(state)[mine]))
+    states = contact.results.slip_states(state)
     fit = fit_hertz_profile(np.abs(x), p, ref["a"])
+    if sphere:
+        # πc² = the sticking nodes' area, twice that of the half model
+        area = comm.allreduce(float(np.sum(state.lumped_weights[mine][states[mine] == 1])))
+        c = float(np.sqrt(2 * area / np.pi))
+    else:
+        c = stick_zone(x, np.concatenate(comm.allgather(states[mine])))
     q = contact.results.tangential_tractions(state)[:, 0]
     tab = slave.tabulate(6, transformed=False)
     q_hat = np.einsum("cqb,cb->cq", tab.phi, q[slave.cells])
-    xq = tab.points[..., 0]
-    near = (np.abs(xq) < 1.5 * ref["a"]) & (tab.points[..., 1] < 0.5 * args.radius)
-    # the traction on the upper body opposes Q: compare it with q(x) ≥ 0
+    rq = (np.linalg.norm(tab.points[..., :2], axis=-1) if sphere else tab.points[..., 0])
+    near = (np.abs(rq) < 1.5 * ref["a"]) & (tab.points[..., -1] < 0.5 * args.radius)
+    # the traction on the upper body opposes Q: compare it with q ≥ 0
     orientation = -np.sign(args.tangential) if args.tangential else 1.0
-    exact = tangential_traction(xq, ref, args.mu)
+    exact = tangential_traction(rq, ref, args.mu)
     err2 = comm.allreduce(float(np.sum((tab.weights * (orientation * q_hat - exact) ** 2)[near])))
     ref2 = comm.allreduce(float(np.sum((tab.weights * exact ** 2)[near])))
     summary = contact.results.friction_summary(state)
-    return {"a": fit.a, "p0": fit.p0, "c": stick_zone(x, states),
+    return {"a": fit.a, "p0": fit.p0, "c": c,
             "q_l2_error": float(np.sqrt(err2 / ref2)) if ref2 > 0 else float("nan"),
             "normal_force": contact.results.normal_force(state),
             "tangential_force": summary["tangential_force"],
@@ -211,17 +261,12 @@ def results(args: argparse.Namespace, contact, ref: dict) -> dict:
 
 
 def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
-    if args.geometry == "sphere":
-        raise NotImplementedError("the sphere's Cattaneo–Mindlin problem is 3D (a lateral "
-                                  "force is not axisymmetric); only the cylinder is built")
     ref = reference(args)
     clock = time.perf_counter()
     contact, problem, approach, shift, h = build(args, ref, comm)
-    holder = Holder(contact, problem, approach, shift, args.load_steps)
-    # the approach of two cylinders (Johnson §5.6), a first guess for δ
-    E_star = args.E / (2 * (1 - args.nu ** 2))
-    guess = args.force / (np.pi * E_star) * (2 * np.log(4 * args.radius / ref["a"]) - 1)
-    holder.reach(approach, 0, args.force, -guess)
+    holder = Holder(contact, problem, approach, shift, args.load_steps,
+                    share=0.5 if args.geometry == "sphere" else 1.0)
+    holder.reach(approach, 0, args.force, -ref["approach"])
     if args.tangential > 0:
         holder.steps = args.tangential_steps
         # below the tangential stiffness of full stick: reached from below

@@ -139,3 +139,53 @@ def half_disk_pair_mesh(radius: float, a: float, h_contact: float, degree: int,
     finally:
         gmsh.finalize()
     return domain, facet_tags
+
+
+#: the symmetry plane y = 0 of :func:`half_sphere_pair_mesh`
+SYMMETRY_Y = 6
+
+
+def half_sphere_pair_mesh(radius: float, a: float, h_contact: float, comm: MPI.Comm):
+    """Two equal hemispheres touching at the origin, cut in half by the plane
+    y = 0 (a lateral load along x keeps that symmetry): the upper one
+    {z ≤ R, |x − (0, 0, R)| ≤ R, y ≥ 0} and its mirror about z = 0, graded
+    towards the contact point from ``h_contact`` within 1.3a to R/5.
+
+    Returns the DOLFINx mesh and its facet tags: SLAVE (the upper sphere),
+    MASTER (the lower one), LOAD (z = R), FIXED (z = −R), SYMMETRY_Y (y = 0).
+    """
+    import gmsh
+    from dolfinx_mortar.io.gmsh_io import grade_towards_point, model_to_mesh
+    R = radius
+    gmsh.initialize(["", "-v", "0"])
+    try:
+        if comm.rank == 0:
+            occ = gmsh.model.occ
+            upper, _ = occ.intersect([(3, occ.addSphere(0, 0, R, R))],
+                                     [(3, occ.addBox(-R, 0, 0, 2 * R, R, R))])
+            lower, _ = occ.intersect([(3, occ.addSphere(0, 0, -R, R))],
+                                     [(3, occ.addBox(-R, 0, -R, 2 * R, R, R))])
+            occ.synchronize()
+            tags: dict = {SLAVE: [], MASTER: [], LOAD: [], FIXED: [], SYMMETRY_Y: []}
+            tol = 1e-6 * R
+            for body, curved in ((upper, SLAVE), (lower, MASTER)):
+                for _, s in gmsh.model.getBoundary(body, oriented=False):
+                    _, y, z = occ.getCenterOfMass(2, s)
+                    if abs(y) < tol:
+                        tags[SYMMETRY_Y].append(s)
+                    elif abs(z - R) < tol:
+                        tags[LOAD].append(s)
+                    elif abs(z + R) < tol:
+                        tags[FIXED].append(s)
+                    else:
+                        tags[curved].append(s)
+            for tag, surfaces in tags.items():
+                gmsh.model.addPhysicalGroup(2, surfaces, tag)
+            gmsh.model.addPhysicalGroup(3, [upper[0][1]], 10)
+            gmsh.model.addPhysicalGroup(3, [lower[0][1]], 11)
+            grade_towards_point((0, 0, 0), h_contact, R / 5, 1.3 * a, 1.3 * a + 12 * (R / 5))
+            gmsh.model.mesh.generate(3)
+        domain, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=3)
+    finally:
+        gmsh.finalize()
+    return domain, facet_tags
