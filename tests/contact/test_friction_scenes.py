@@ -114,8 +114,10 @@ def test_the_output_carries_the_tangential_traction_and_the_states(tmp_path_fact
     _, states = data.field("stick_slip")
     assert set(np.unique(states[-1])) <= {0.0, 1.0, 2.0}
     _, q = data.field("q_hat_x")
-    # the traction on the block opposes the push Q = 0.002 (per unit length)
-    assert np.all(q[-1] <= 0) and np.min(q[-1]) < -1e-4
+    # the traction on the block opposes the push Q = 0.002 (per unit length); a node
+    # that carries none reads ±round-off (6e-20 with another CPU's BLAS)
+    scale = np.max(np.abs(q[-1]))
+    assert scale > 1e-4 and np.all(q[-1] <= 1e-12 * scale)
 
 
 @pytest.mark.parametrize("options, message", [
