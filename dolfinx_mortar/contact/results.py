@@ -118,9 +118,12 @@ class ContactResults:
     def contact_force(self, state: Optional[ContactState] = None) -> FloatArray:
         """The resultant of the contact traction on the slave body, a gdim-vector:
         ``−Σ R_c`` over the slave nodes' dofs, summed over all ranks."""
-        state = state or self.term.evaluate()
+        return self._slave_resultant((state or self.term.evaluate()).residual)
+
+    def _slave_resultant(self, residual: PETSc.Vec) -> FloatArray:
+        """``−Σ residual`` over the slave nodes' owned dofs, summed over all ranks."""
         gdim = self.term.slave.gdim
-        R = state.residual.array_r.reshape(-1, gdim)
+        R = residual.array_r.reshape(-1, gdim)
         nodes = np.unique(self.term.slave.cells)
         nodes = nodes[nodes < self.term.slave.layout.num_owned]
         local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
@@ -162,13 +165,7 @@ class ContactResults:
         """The resultant of the tangential (friction) traction on the slave
         body, a gdim-vector over all ranks: ``−Σ G_Tᵀ f_T`` over the slave
         nodes' dofs, as :meth:`contact_force` is of the whole traction."""
-        friction = self._friction(state)
-        gdim = self.term.slave.gdim
-        R = friction.residual.array_r.reshape(-1, gdim)
-        nodes = np.unique(self.term.slave.cells)
-        nodes = nodes[nodes < self.term.slave.layout.num_owned]
-        local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
-        return np.asarray(self.term.mesh.comm.allreduce(local))
+        return self._slave_resultant(self._friction(state).residual)
 
     def dissipation(self) -> float:
         """The frictional dissipation ``Σ_steps Σ_A f_T,A · Δy_p,A`` over the
