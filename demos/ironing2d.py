@@ -1,6 +1,6 @@
 """Ironing in 2D after Puso & Laursen (2004): a stiff half-cylindrical die pressed into a
-neo-Hookean slab and slid along it, frictionless on the current configuration, or with
-Coulomb friction (``--mu 0.3``, the paper's) on the previous one.
+neo-Hookean slab and slid along it on the current configuration, frictionless or with
+Coulomb friction (``--mu 0.3``, the paper's).
 
 The scene, its outputs and the figures: :mod:`demo_support.ironing`.
 

@@ -41,7 +41,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.contact.gaps import GapModelBase
-from dolfinx_mortar.contact.penalty_law import PenaltyLaw, safe_weights
+from dolfinx_mortar.contact.penalty_law import PenaltyLaw, positive_part, safe_weights
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, is_global, kind_name
@@ -286,6 +286,19 @@ class CurrentSurfaceGap(GapModelBase):
             scaled.diagonalScale(layout.vector(by_W), None)
             G_y.axpy(1.0, scaled, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return G_y
+
+    def normal_force_derivative(self, state: ContactState, active: FloatArray) -> PETSc.Mat:
+        """``∂f_N/∂u`` of ``f_N = ε W^m ⟨y⟩`` on the current surface:
+        ``diag(ωH) ∂y/∂u + diag(ε m W^(m−1) ⟨y⟩) ∂W/∂u`` (``active`` as H(y))."""
+        current, layout = state.data, self.slave.layout
+        D = current.G_y.copy()
+        D.diagonalScale(layout.vector(state.weights * active), None)
+        by_W = self.law.weight_derivative(safe_weights(current.W)) * positive_part(current.y)
+        scaled = current.G_W.copy()
+        scaled.diagonalScale(layout.vector(by_W), None)
+        D.axpy(1.0, scaled, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        scaled.destroy()
+        return D
 
     def jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
                  geometric: bool = True) -> PETSc.Mat:

@@ -21,6 +21,14 @@ contact's normal nodal forces,
   normals and integrals within a step),
 - Jacobian ``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ωH G)``, unsymmetric in slip.
 
+On the current surface (``basis_configuration="current"``) the normal contact
+follows u and the slip is measured as above on the model frozen where the
+step starts (its tangent planes, mortar integrals and ω_T, made again for
+each step): Δy_T stays linear within a step, so G_T is constant and the
+Jacobian exact for it, with ``∂f_N/∂u`` of the current surface (W moves too).
+A rotation of the contact within one step is then seen as slip to first
+order in the step's rotation.
+
 The history (the tangential forces and the displacement of the last accepted
 step) changes only in :meth:`Friction.accept`, called by the load-path driver
 when a step has converged: a cut-back retries from the same history.
@@ -28,7 +36,7 @@ when a step has converged: a cut-back retries from the same history.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 import numpy.typing as npt
@@ -49,9 +57,8 @@ FloatArray = npt.NDArray[np.float64]
 DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 
 
-def check_friction_options(options: ContactOptions, follows_u: bool) -> None:
-    """NotImplementedError naming a combination friction does not support, and why
-    (``follows_u``: the bases are on the current surface)."""
+def check_friction_options(options: ContactOptions) -> None:
+    """NotImplementedError naming a combination friction does not support, and why."""
     if is_global(options.kind):
         raise NotImplementedError(
             f"friction with {kind_name(options.kind)}: the tangential forces of the global "
@@ -60,12 +67,6 @@ def check_friction_options(options: ContactOptions, follows_u: bool) -> None:
     if options.law.pointwise:
         raise NotImplementedError("friction with active_set='pointwise': the Coulomb cone is "
                                   "set by the nodal normal forces; use active_set='nodal'")
-    if follows_u:
-        raise NotImplementedError(
-            "friction with basis_configuration='current': the slip on the current surface "
-            "needs the derivatives of its tangent planes and mortar integrals in the "
-            "tangential directions, which the kernels do not give yet; use 'previous' "
-            "(the tangent planes follow each converged step) or 'initial'")
 
 
 @dataclass
@@ -141,6 +142,7 @@ class _SlipOperator:
     G_T: PETSc.Mat
     projectors: FloatArray              # P_A, (nodes, gdim, gdim)
     obstacle_weights: Optional[FloatArray]  # (∫ M̄_A) P_A for the obstacle's motion
+    weights: FloatArray                 # ω = ε W^m of the model it was made from
 
 
 def _projectors(normals: FloatArray) -> FloatArray:
@@ -163,13 +165,16 @@ class Friction:
         The slave surface (:class:`~dolfinx_mortar.surfaces.lagrange.LagrangeSurface`).
     obstacle
         The term's rigid obstacle, or None.
-    follows_u
-        The term's bases are on the current surface (refused).
+    step_start_model
+        On the current surface: makes the model frozen in a configuration
+        (nodal displacement, the same as a vector), on which each step's slip
+        is measured; None where the term's own model is frozen.
     """
 
     def __init__(self, law: CoulombFriction, options: ContactOptions, u, slave,
-                 obstacle: Optional[RigidObstacle] = None, follows_u: bool = False):
-        check_friction_options(options, follows_u)
+                 obstacle: Optional[RigidObstacle] = None,
+                 step_start_model: Optional[Callable[[FloatArray, PETSc.Vec], Any]] = None):
+        check_friction_options(options)
         self.law = law
         self.normal_law = options.law
         #: ε_T
@@ -181,25 +186,32 @@ class Friction:
             np.zeros((slave.layout.size_local, slave.gdim)), u.x.petsc_vec.copy(),
             nodal_displacement(slave, u),
             None if obstacle is None else np.array(obstacle.displacement, dtype=float))
+        self._step_start_model = step_start_model
         self._operator: Optional[_SlipOperator] = None
         #: the stick/slip states of the last Jacobian (the exact slip tangent
         #: once they repeat)
         self._jacobian_states: Optional[npt.NDArray[np.int8]] = None
         #: the model and the step the slip operator was made for
-        self._operator_for: tuple = (None, -1)
+        self._operator_for: tuple = (None, -2)
 
     # -- the slip operator of a step ---------------------------------------------------
     def _slip_operator(self, model) -> _SlipOperator:
         """The slip operator of the present step: made again for a new model
         and, against an obstacle (whose tangent planes are those where the step
-        starts), for every new step."""
-        obstacle = isinstance(model, ObstacleGap)
-        step = self.history.version if obstacle else -1
+        starts), for every new step; on the current surface from the model
+        frozen where the step starts, for every new step."""
+        h = self.history
+        if self._step_start_model is not None:
+            model, key = None, (None, h.version)
+        else:
+            key = (model, h.version if isinstance(model, ObstacleGap) else -1)
         made_for, made_at = self._operator_for
-        if self._operator is None or made_for is not model or made_at != step:
-            self._operator = (self._obstacle_operator(model) if obstacle
+        if self._operator is None or made_for is not key[0] or made_at != key[1]:
+            if model is None:
+                model = self._step_start_model(h.u_nodes, h.u.copy())
+            self._operator = (self._obstacle_operator(model) if isinstance(model, ObstacleGap)
                               else self._mortar_operator(model))
-            self._operator_for = (model, step)
+            self._operator_for = key
         return self._operator
 
     def _assemble(self, model, cells, cols, blocks, projectors) -> PETSc.Mat:
@@ -215,7 +227,7 @@ class Friction:
         cells, cols, blocks = model.pair_operators
         projectors = _projectors(model.coupling.normals)
         return _SlipOperator(self._assemble(model, cells, cols, blocks, projectors),
-                             projectors, None)
+                             projectors, None, model.weights)
 
     def _obstacle_operator(self, model: ObstacleGap) -> _SlipOperator:
         """Tangent planes of the obstacle below each node where the step starts
@@ -233,7 +245,7 @@ class Friction:
         cols = model.node_dofs(cells).reshape(nc, nd * self.slave.gdim)
         mass = self.slave.layout.sum_at_functions(cells, blocks.sum(axis=2))
         return _SlipOperator(self._assemble(model, cells, cols, blocks, projectors),
-                             projectors, mass[:, None, None] * projectors)
+                             projectors, mass[:, None, None] * projectors, model.weights)
 
     # -- evaluation --------------------------------------------------------------------
     def evaluate(self, model, state: ContactState, u, active: FloatArray,
@@ -253,7 +265,7 @@ class Friction:
         if operator.obstacle_weights is not None:
             motion = np.asarray(self.obstacle.displacement) - h.obstacle_displacement
             slip -= operator.obstacle_weights @ motion
-        weights = state.weights * (self.penalty / self.normal_law.penalty)
+        weights = operator.weights * (self.penalty / self.normal_law.penalty)
         history = np.einsum("aik,ak->ai", operator.projectors, h.forces)
         trial = history + weights[:, None] * slip
         mapping = self.law.return_mapping(trial, state.force, weights, active > 0)
@@ -283,7 +295,7 @@ class Friction:
 
     def jacobian(self, model, state: ContactState, friction: FrictionState,
                  active: FloatArray) -> PETSc.Mat:
-        """``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ωH G)`` at ``friction``."""
+        """``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ∂f_N/∂u)`` at ``friction``."""
         mapping = friction.mapping
         states = mapping.state
         # the exact slip tangent (0 along t in 2D) lets a slipping node's
@@ -296,13 +308,20 @@ class Friction:
                                       op=MPI.LAND)
         self._jacobian_states = states.copy()
         tangent = mapping.tangent if settled else mapping.secant_tangent()
+        return self._product(model, friction, tangent, mapping.normal_tangent,
+                             model.normal_force_derivative(state, active))
+
+    def _product(self, model, friction: FrictionState, tangent: FloatArray,
+                 normal_tangent: FloatArray, D: PETSc.Mat) -> PETSc.Mat:
+        """``G_Tᵀ (C G_T + B D)`` with node blocks C = ``tangent`` and B =
+        ``normal_tangent``, and ``D = ∂f_N/∂u``."""
         C = self._node_blocks(model, tangent, "dofs")
-        B = self._node_blocks(model, mapping.normal_tangent
-                              * (state.weights * active)[:, None], "nodes")
+        B = self._node_blocks(model, normal_tangent, "nodes")
         J = C.matMult(friction.G_T)
-        J.axpy(1.0, B.matMult(state.G), structure=DIFFERENT)
+        BD = B.matMult(D)
+        J.axpy(1.0, BD, structure=DIFFERENT)
         K = transpose_mat_mult(friction.G_T, J)
-        for m in (C, B, J):
+        for m in (C, B, J, BD, D):
             m.destroy()
         return K
 
@@ -310,11 +329,8 @@ class Friction:
         """Every entry :meth:`jacobian` may have (stick and slip at every node)."""
         gdim = self.slave.gdim
         n = self.slave.layout.size_local
-        C = self._node_blocks(model, np.ones((n, gdim, gdim)), "dofs")
-        B = self._node_blocks(model, np.ones((n, gdim)), "nodes")
-        J = C.matMult(friction.G_T)
-        J.axpy(1.0, B.matMult(state.G), structure=DIFFERENT)
-        return transpose_mat_mult(friction.G_T, J)
+        return self._product(model, friction, np.ones((n, gdim, gdim)), np.ones((n, gdim)),
+                             model.normal_force_derivative(state, np.ones(n)))
 
     # -- the history -------------------------------------------------------------------
     def accept(self, friction: FrictionState, u) -> None:

@@ -136,6 +136,14 @@ class GapModelBase:
             K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         return K
 
+    def normal_force_derivative(self, state: ContactState, active: FloatArray) -> PETSc.Mat:
+        """``∂f_N/∂u`` of the nodal normal forces ``f_N = ω⟨y⟩`` (slave nodes ×
+        dofs, Dirichlet columns dropped), ``active`` (0/1) as H(y): ``diag(ωH) G``
+        with W frozen (friction's cone follows it)."""
+        D = state.G.copy()
+        D.diagonalScale(self.slave.layout.vector(state.weights * active), None)
+        return D
+
     def nodal_force(self, values: FloatArray) -> FloatArray:
         """The nodal force f of ``R_c = Gᵀ f`` for nodal values ω⟨d̄⟩ (here: themselves)."""
         return values

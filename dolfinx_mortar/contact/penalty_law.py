@@ -108,6 +108,10 @@ class PenaltyLaw:
         """``ω_A = ε W_A^m`` of Π_c = Σ (ω_A/2)⟨y_A⟩²."""
         return self.penalty * W ** self.m
 
+    def weight_derivative(self, W: FloatArray) -> FloatArray:
+        """``∂ω_A/∂W_A = ε m W_A^(m−1)`` (W as :func:`safe_weights`)."""
+        return self.penalty * self.m * W ** (self.m - 1) if self.m else np.zeros_like(W)
+
     def force(self, weights: FloatArray, gaps: FloatArray,
               gaps_plus: Optional[FloatArray] = None) -> FloatArray:
         """The nodal force ``ω⟨y⟩`` (pointwise: ``ω y⁺``) of ``R_c = Gᵀ force``."""

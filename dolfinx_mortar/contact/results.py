@@ -177,12 +177,13 @@ class ContactResults:
     def stored_energy(self, state: Optional[ContactState] = None) -> float:
         """The energy stored in the contact's penalty springs over all ranks:
         ``Σ_A (ω_A/2)⟨y_A⟩²`` (normal) plus, with friction,
-        ``Σ_A |f_T,A|²/(2ω_T,A)`` (tangential); for the nodal active set on
-        frozen bases, where the normal law has this potential."""
+        ``Σ_A |f_T,A|²/(2ω_T,A)`` (tangential); for the nodal active set, where
+        the normal law has this potential (ω and y of the current surface with
+        ``basis_configuration="current"``)."""
         state = state or self.term.evaluate()
-        if self.term.options.law.pointwise or self.term.configuration.follows_u:
-            raise NotImplementedError("the stored energy is that of the nodal active set on "
-                                      "frozen bases ('initial' or 'previous')")
+        if self.term.options.law.pointwise:
+            raise NotImplementedError("the stored energy is that of the nodal active set: "
+                                      "the pointwise one has no potential")
         n = self.term.slave.layout.num_owned
         normal = np.sum(self.term.options.law.potential(state.weights, state.gaps)[:n])
         energy = float(self.term.mesh.comm.allreduce(float(normal)))

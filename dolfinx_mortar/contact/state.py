@@ -81,5 +81,8 @@ class GapModel(Protocol):
 
     def mortar_traction(self, state: ContactState) -> FloatArray: ...
 
+    def normal_force_derivative(self, state: ContactState, active: FloatArray) -> PETSc.Mat:
+        """``∂f_N/∂u`` of the nodal normal forces (slave nodes × dofs), ``active`` as H."""
+
     def nodal_force(self, values: FloatArray) -> FloatArray:
         """The nodal force f of ``R_c = Gᵀ f`` for nodal values ω⟨d̄⟩."""

@@ -148,9 +148,13 @@ class ContactTerm:
         #: its checks of the model's range
         self.checks = RangeChecks(self)
         #: Coulomb friction and its history (None: frictionless)
-        self.friction: Optional[Friction] = (
-            Friction(friction, options, u, self.slave, obstacle,
-                     self.configuration.follows_u) if friction is not None else None)
+        self.friction: Optional[Friction] = None
+        if friction is not None:
+            step_start = None
+            if self.configuration.follows_u:
+                def step_start(u_nodes, u_vector):
+                    return self.configuration.frozen_model_at(self.options, u_nodes, u_vector)
+            self.friction = Friction(friction, options, u, self.slave, obstacle, step_start)
         self.model: GapModel = self._timed_build(self.configuration.build, options)
         self.checks.warn_deep_initial_penetration()
         self.checks.warn_if_no_master_is_in_reach(self.configuration.segmentation(self.model))

@@ -21,18 +21,19 @@ from support.scenes import block_on_plane
 PLANE = [0.0, 0.0], [0.0, 1.0]
 
 
-def pressed(friction) -> ContactProblem:
+def pressed(friction, configuration: str = "initial") -> ContactProblem:
     V, tags = block_on_plane(n=(8, 4))
     return ContactProblem(V, tags, 1, obstacle=RigidPlane(*PLANE), E=1.0, nu=0.3,
                           penalty=50.0, fixed={3: {0: 0.0}}, tractions={2: [0.002, -0.01]},
-                          friction=friction)
+                          basis_configuration=configuration, friction=friction)
 
 
-def test_no_friction_coefficient_is_the_frictionless_problem():
+@pytest.mark.parametrize("configuration", ["initial", "current"])
+def test_no_friction_coefficient_is_the_frictionless_problem(configuration):
     """μ = 0 runs the friction machinery and must change nothing, node by node."""
     results = []
     for friction in (None, CoulombFriction(0.0)):
-        problem = pressed(friction)
+        problem = pressed(friction, configuration)
         problem.solve(load_steps=2)
         results.append((problem.u.x.array.copy(), problem.nodal_pressures()))
     assert np.allclose(results[0][0], results[1][0], rtol=0, atol=1e-14)
@@ -55,7 +56,14 @@ def test_the_history_moves_only_with_an_accepted_step():
     assert np.array_equal(contact.results.tangential_tractions(), accepted)
 
 
-def test_a_load_unload_cycle_balances_its_energy():
+#: the energy balance's tolerance: the Newton tolerance on frozen bases; on the
+#: current surface the tangential springs' stiffness ω_T = ε_T W^m follows W
+#: from step to step, and a spring that keeps its force changes its energy
+BALANCE = {"initial": 1e-8, "current": 1e-4}
+
+
+@pytest.mark.parametrize("configuration", ["initial", "current"])
+def test_a_load_unload_cycle_balances_its_energy(configuration):
     """A block pressed on a plane by G, then pushed sideways by Q up to 0.9
     μG, back to −0.9 μG and to 0 (partial slip, held by friction alone): the
     work of the loads (trapezoidal rule) equals the strain energy plus the
@@ -65,7 +73,7 @@ def test_a_load_unload_cycle_balances_its_energy():
     V, tags = block_on_plane(n=(8, 4))
     u = fem.Function(V)
     contact = ContactTerm(u, tags, 1, obstacle=RigidPlane(*PLANE), penalty=50.0,
-                          friction=CoulombFriction(0.3))
+                          basis_configuration=configuration, friction=CoulombFriction(0.3))
     normal = fem.Constant(V.mesh, PETSc.ScalarType(0.0))
     shear = fem.Constant(V.mesh, PETSc.ScalarType(0.0))
     v = ufl.TestFunction(V)
@@ -100,7 +108,7 @@ def test_a_load_unload_cycle_balances_its_energy():
     stored = comm.allreduce(fem.assemble_scalar(strain)) + contact.results.stored_energy()
     dissipation = contact.results.dissipation()
     assert dissipation > 1e-3 * work[0]           # it did slip
-    assert work[0] == pytest.approx(stored + dissipation, rel=1e-8)
+    assert work[0] == pytest.approx(stored + dissipation, rel=BALANCE[configuration])
 
 
 def test_the_output_carries_the_tangential_traction_and_the_states(tmp_path_factory):
@@ -122,8 +130,7 @@ def test_the_output_carries_the_tangential_traction_and_the_states(tmp_path_fact
 
 @pytest.mark.parametrize("options, message", [
     ({"kind": "GLS"}, "global kinds"), ({"kind": "GLS*"}, "global kinds"),
-    ({"active_set": "pointwise", "kind": "LmLS*"}, "pointwise"),
-    ({"basis_configuration": "current"}, "current")])
+    ({"active_set": "pointwise", "kind": "LmLS*"}, "pointwise")])
 def test_unsupported_combinations_say_why(options, message):
     V, tags = block_on_plane(n=(4, 2))
     u = fem.Function(V)

@@ -1,6 +1,8 @@
 """The exact friction Jacobian: central differences of the residual against it,
 with sticking and slipping nodes at once, before and after a step's forces
-became history, for rigid obstacles and two bodies, 2D, 3D and axisymmetric."""
+became history, for rigid obstacles and two bodies, 2D, 3D and axisymmetric,
+on frozen bases and on the current surface (where the cone's normal force
+moves with W as well as with the gap)."""
 from __future__ import annotations
 
 import numpy as np
@@ -96,13 +98,34 @@ def test_block_on_an_obstacle(kind, scaling, obstacle):
     check_both_branches(block(shape, kind, scaling), first_2d, second_2d)
 
 
-@pytest.mark.parametrize("configuration", ["initial", "previous"])
+@pytest.mark.parametrize("kind", ["LcLS*", "LmLS"])
+@pytest.mark.parametrize("obstacle", ["plane", "disk"])
+def test_block_on_an_obstacle_current(kind, obstacle):
+    shape = (RigidPlane([0, 0], [0, 1]) if obstacle == "plane"
+             else RigidSphere([0.5, -50.0], 50.0))
+    check_both_branches(block(shape, kind, configuration="current"), first_2d, second_2d)
+
+
+def on_the_axis(values):
+    """``values`` with u_r = 0 on the axis (r = x = 0), where the surface must
+    stay (the current surface is checked for r ≥ 0)."""
+    def scaled(x):
+        u = values(x)
+        u[0] *= 2 * x[0]
+        return u
+    return scaled
+
+
+@pytest.mark.parametrize("configuration", ["initial", "previous", "current"])
 def test_axisymmetric_block_on_a_plane(configuration):
-    check_both_branches(block(RigidPlane([0, 0], [0, 1]), axisymmetric=True,
-                              configuration=configuration), first_2d, second_2d)
+    # the dual kinds on the current axisymmetric surface are refused
+    kind = "LmLS" if configuration == "current" else "LcLS*"
+    check_both_branches(block(RigidPlane([0, 0], [0, 1]), kind=kind, axisymmetric=True,
+                              configuration=configuration),
+                        on_the_axis(first_2d), on_the_axis(second_2d))
 
 
-def box(obstacle, kind: str) -> ContactProblem:
+def box(obstacle, kind: str, configuration: str = "initial") -> ContactProblem:
     domain = mesh.create_box(MPI.COMM_WORLD, [[0, 0, 0], [1, 1, 0.5]], [4, 4, 2])
     fdim = 2
     marks = [(1, lambda x: np.isclose(x[2], 0.0)), (2, lambda x: np.isclose(x[2], 0.5))]
@@ -117,7 +140,7 @@ def box(obstacle, kind: str) -> ContactProblem:
     V = fem.functionspace(domain, ("Lagrange", 1, (3,)))
     problem = ContactProblem(V, tags, 1, obstacle=obstacle, E=1.0, nu=0.3, kind=kind,
                              penalty=50.0, tractions={2: [0.002, 0.0, -0.01]},
-                             friction=friction(50.0))
+                             basis_configuration=configuration, friction=friction(50.0))
     problem.set_load(1.0)
     return problem
 
@@ -140,6 +163,13 @@ def test_box_on_an_obstacle(kind, obstacle):
     check_both_branches(box(shape, kind), first_3d, second_3d)
 
 
+@pytest.mark.parametrize("obstacle", ["plane", "sphere"])
+def test_box_on_an_obstacle_current(obstacle):
+    shape = (RigidPlane([0, 0, 0], [0, 0, 1]) if obstacle == "plane"
+             else RigidSphere([0.5, 0.5, -50.0], 50.0))
+    check_both_branches(box(shape, "LcLS*", "current"), first_3d, second_3d)
+
+
 def two_blocks(dim: int, kind: str, configuration: str) -> tuple[ContactProblem, np.ndarray]:
     """The patch test's non-matching blocks; the upper one's cells."""
     demo = load_demo("patch_test")
@@ -159,7 +189,7 @@ def two_blocks(dim: int, kind: str, configuration: str) -> tuple[ContactProblem,
 
 
 @pytest.mark.parametrize("kind", LOCAL_KINDS)
-@pytest.mark.parametrize("configuration", ["initial", "previous"])
+@pytest.mark.parametrize("configuration", ["initial", "previous", "current"])
 def test_two_blocks_2d(kind, configuration):
     problem, upper = two_blocks(2, kind, configuration)
     check_both_branches(
@@ -167,9 +197,10 @@ def test_two_blocks_2d(kind, configuration):
         lambda x: np.vstack([5.3e-4 * (x[0] - 0.47), -1.31e-4 - 2.03e-4 * x[0]]), upper)
 
 
-@pytest.mark.parametrize("kind", ["LcLS*", "LmLS*"])
-def test_two_blocks_3d(kind):
-    problem, upper = two_blocks(3, kind, "initial")
+@pytest.mark.parametrize("kind, configuration", [("LcLS*", "initial"), ("LmLS*", "initial"),
+                                                 ("LmLS*", "current")])
+def test_two_blocks_3d(kind, configuration):
+    problem, upper = two_blocks(3, kind, configuration)
     check_both_branches(
         problem, lambda x: np.vstack([3.1e-4 * (x[0] - 0.47), 1.1e-4 * (x[1] - 0.53),
                                       -1.07e-4 - 2.03e-4 * x[0]]),

@@ -79,6 +79,9 @@ def residual_difference(problem, x0, direction, size: float = 1e-6):
         b = problem.problem.vector().duplicate()
         problem.problem.F(x, b)
         residuals.append(b)
+    # the residual left u at x0 − h v: back to x0 for whatever the caller does next
+    x0.copy(problem.u.x.petsc_vec)
+    problem.u.x.scatter_forward()
     fd = residuals[0].copy()
     fd.axpy(-1.0, residuals[1])
     fd.scale(1 / (2 * h))
