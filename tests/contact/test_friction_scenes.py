@@ -21,11 +21,11 @@ from support.scenes import block_on_plane
 PLANE = [0.0, 0.0], [0.0, 1.0]
 
 
-def pressed(friction, configuration: str = "initial") -> ContactProblem:
+def pressed(friction, configuration: str = "initial", **solver) -> ContactProblem:
     V, tags = block_on_plane(n=(8, 4))
     return ContactProblem(V, tags, 1, obstacle=RigidPlane(*PLANE), E=1.0, nu=0.3,
                           penalty=50.0, fixed={3: {0: 0.0}}, tractions={2: [0.002, -0.01]},
-                          basis_configuration=configuration, friction=friction)
+                          basis_configuration=configuration, friction=friction, **solver)
 
 
 @pytest.mark.parametrize("configuration", ["initial", "current"])
@@ -38,6 +38,30 @@ def test_no_friction_coefficient_is_the_frictionless_problem(configuration):
         results.append((problem.u.x.array.copy(), problem.nodal_pressures()))
     assert np.allclose(results[0][0], results[1][0], rtol=0, atol=1e-14)
     assert np.allclose(results[0][1], results[1][1], rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("configuration", ["initial", "current"])
+def test_the_iterative_path_solves_the_unsymmetric_friction_jacobian(configuration):
+    """The iterative linear path (GMRES, as friction's Jacobian is unsymmetric,
+    with multigrid and an exact contact block) gives the direct path's
+    solution and stick/slip states, with sticking and slipping nodes."""
+    runs = []
+    for linear_solver in ("direct", "iterative"):
+        problem = pressed(CoulombFriction(0.15), configuration, linear_solver=linear_solver,
+                          petsc_options={"snes_ksp_ew": False, "ksp_rtol": 1e-12})
+        result = problem.solve(load_steps=2)
+        runs.append((problem.u.x.array.copy(), problem.contact.results.slip_states(),
+                     problem.solver.default_options().get("ksp_type"), result))
+    (u_direct, states_direct, _, _), (u_krylov, states_krylov, ksp, result) = runs
+    assert ksp == "gmres"
+    assert result.linear_iterations > result.newton_iterations      # Krylov, not LU
+    comm = MPI.COMM_WORLD
+    assert comm.allreduce(int(np.sum(states_direct == 1))) > 0     # sticking
+    assert comm.allreduce(int(np.sum(states_direct == 2))) > 0     # and slipping
+    assert np.array_equal(states_direct, states_krylov)
+    scale = comm.allreduce(float(np.max(np.abs(u_direct))), op=MPI.MAX)
+    difference = comm.allreduce(float(np.max(np.abs(u_direct - u_krylov))), op=MPI.MAX)
+    assert difference < 1e-8 * scale
 
 
 def test_the_history_moves_only_with_an_accepted_step():

@@ -104,9 +104,11 @@ def test_cattaneo_mindlin_every_local_kind(kind):
     assert f["q_l2_error"] < 0.07
 
 
-def test_slip_limit_same_on_one_and_all_ranks():
+@pytest.mark.parametrize("configuration", ["initial", "current"])
+def test_slip_limit_same_on_one_and_all_ranks(configuration):
     demo = load_demo("slip_limit")
-    args = demo.parse_args(["--tan-alpha", "0.2", "--mu", "0.3", "--push-steps", "4"])
+    args = demo.parse_args(["--tan-alpha", "0.2", "--mu", "0.3", "--push-steps", "4",
+                            "--basis-configuration", configuration])
     rows = [demo.run(args, comm)["steps"] for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)]
     for a, b in zip(*rows):
         assert a["F"] == pytest.approx(b["F"], rel=1e-8, abs=1e-14)
