@@ -48,8 +48,7 @@ from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.state import ContactState
-from dolfinx_mortar.kinds import is_global, kind_name
-from dolfinx_mortar.layout import assemble_blocks
+from dolfinx_mortar.layout import MassMatrixSolver, assemble_blocks
 from dolfinx_mortar.linalg.sparse_products import transpose_mat_mult
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 
@@ -59,11 +58,6 @@ DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 
 def check_friction_options(options: ContactOptions) -> None:
     """NotImplementedError naming a combination friction does not support, and why."""
-    if is_global(options.kind):
-        raise NotImplementedError(
-            f"friction with {kind_name(options.kind)}: the tangential forces of the global "
-            "kinds act through L⁻¹ (dense), which the augmented Newton step does not carry "
-            "for the tangential directions; use a local kind (LmLS*, LmLS, LcLS*, LcLS)")
     if options.law.pointwise:
         raise NotImplementedError("friction with active_set='pointwise': the Coulomb cone is "
                                   "set by the nodal normal forces; use active_set='nodal'")
@@ -137,17 +131,62 @@ class FrictionState:
 
 @dataclass
 class _SlipOperator:
-    """The linear map of a step: ``Δy_T = to_local(G_T Δu) + shift (Δc)``."""
+    """The linear map of a step: ``Δy_T = to_local(G_T Δu) − obstacle_weights Δc``;
+    with ``mass`` (GLS, GLS*) ``Δy_T = P L⁻¹(Ĝ_T Δu − (∫N) Δc)``, G_T then
+    the standard basis's unprojected ``Ĝ_T``."""
 
     G_T: PETSc.Mat
     projectors: FloatArray              # P_A, (nodes, gdim, gdim)
     obstacle_weights: Optional[FloatArray]  # (∫ M̄_A) P_A for the obstacle's motion
     weights: FloatArray                 # ω = ε W^m of the model it was made from
+    mass: Optional[MassMatrixSolver] = None  # L of the global kinds
+
+
+@dataclass
+class AugmentedFriction:
+    """Friction's blocks of the GLS kinds' augmented Newton system (rows and
+    columns node·gdim + i of the slave layout; see
+    :class:`~dolfinx_mortar.contact.augmented.AugmentedNewtonStep`): with
+    ``w = L⁻¹ Ĝ_T Δu`` and ``Δz_T = L⁻¹ Δf_T``, ``Δf_T = PCP w + PBωH Δy``."""
+
+    G_T: PETSc.Mat      #: Ĝ_T, Dirichlet columns dropped
+    PCP: PETSc.Mat      #: P C P per node
+    PB: PETSc.Mat       #: P c_TN ωH per node (columns: the nodes)
+    L: PETSc.Mat        #: L ⊗ I_gdim
+
+
+def kron_identity(L: PETSc.Mat, bs: int) -> PETSc.Mat:
+    """``L ⊗ I_bs`` (row and column i·bs + k from i), on the owned rows."""
+    indptr, cols, values = L.getValuesCSR()
+    n = len(indptr) - 1
+    counts = np.diff(indptr)
+    starts = np.zeros(n * bs + 1, dtype=PETSc.IntType)
+    starts[1:] = np.cumsum(np.repeat(counts, bs))
+    row = np.repeat(np.arange(n), counts)
+    within = np.arange(len(cols)) - indptr[row]
+    new_cols = np.empty(len(cols) * bs, dtype=PETSc.IntType)
+    new_values = np.empty(len(cols) * bs)
+    for k in range(bs):
+        at = starts[row * bs + k] + within
+        new_cols[at] = cols * bs + k
+        new_values[at] = values
+    (m, M), _ = L.getSizes()
+    return PETSc.Mat().createAIJ(size=((m * bs, M * bs), (m * bs, M * bs)),
+                                 csr=(starts, new_cols, new_values), comm=L.comm)
 
 
 def _projectors(normals: FloatArray) -> FloatArray:
     gdim = normals.shape[1]
     return np.eye(gdim)[None] - normals[:, :, None] * normals[:, None, :]
+
+
+def _identities(projectors: FloatArray) -> FloatArray:
+    return np.broadcast_to(np.eye(projectors.shape[1]), projectors.shape)
+
+
+def _solve_components(mass: MassMatrixSolver, values: FloatArray) -> FloatArray:
+    """``L⁻¹`` applied to each component of nodal vectors (nodes, gdim)."""
+    return np.stack([mass.solve(values[:, i]) for i in range(values.shape[1])], axis=1)
 
 
 class Friction:
@@ -204,13 +243,21 @@ class Friction:
         if self._step_start_model is not None:
             model, key = None, (None, h.version)
         else:
-            key = (model, h.version if isinstance(model, ObstacleGap) else -1)
+            source = getattr(model, "inner", model)
+            key = (model, h.version if isinstance(source, ObstacleGap) else -1)
         made_for, made_at = self._operator_for
         if self._operator is None or made_for is not key[0] or made_at != key[1]:
             if model is None:
                 model = self._step_start_model(h.u_nodes, h.u.copy())
-            self._operator = (self._obstacle_operator(model) if isinstance(model, ObstacleGap)
-                              else self._mortar_operator(model))
+            # GLS, GLS*: the standard basis's integrals, projected after L⁻¹
+            inner = getattr(model, "inner", None)
+            source = model if inner is None else inner
+            project = inner is None
+            self._operator = (self._obstacle_operator(source, project)
+                              if isinstance(source, ObstacleGap)
+                              else self._mortar_operator(source, project))
+            if inner is not None:
+                self._operator.mass, self._operator.weights = model.mass, model.weights
             self._operator_for = key
         return self._operator
 
@@ -223,13 +270,14 @@ class Friction:
         return assemble_blocks(model.dofs, rows, model.dofs, cols,
                                values.reshape(nc, nr * gdim, cols.shape[1]))
 
-    def _mortar_operator(self, model: MortarGap) -> _SlipOperator:
+    def _mortar_operator(self, model: MortarGap, project: bool) -> _SlipOperator:
         cells, cols, blocks = model.pair_operators
         projectors = _projectors(model.coupling.normals)
-        return _SlipOperator(self._assemble(model, cells, cols, blocks, projectors),
+        applied = projectors if project else _identities(projectors)
+        return _SlipOperator(self._assemble(model, cells, cols, blocks, applied),
                              projectors, None, model.weights)
 
-    def _obstacle_operator(self, model: ObstacleGap) -> _SlipOperator:
+    def _obstacle_operator(self, model: ObstacleGap, project: bool) -> _SlipOperator:
         """Tangent planes of the obstacle below each node where the step starts
         (the obstacle translated back to where it was then)."""
         h = self.history
@@ -244,8 +292,9 @@ class Friction:
         nc, nd = cells.shape
         cols = model.node_dofs(cells).reshape(nc, nd * self.slave.gdim)
         mass = self.slave.layout.sum_at_functions(cells, blocks.sum(axis=2))
-        return _SlipOperator(self._assemble(model, cells, cols, blocks, projectors),
-                             projectors, mass[:, None, None] * projectors, model.weights)
+        applied = projectors if project else _identities(projectors)
+        return _SlipOperator(self._assemble(model, cells, cols, blocks, applied),
+                             projectors, mass[:, None, None] * applied, model.weights)
 
     # -- evaluation --------------------------------------------------------------------
     def evaluate(self, model, state: ContactState, u, active: FloatArray,
@@ -265,15 +314,24 @@ class Friction:
         if operator.obstacle_weights is not None:
             motion = np.asarray(self.obstacle.displacement) - h.obstacle_displacement
             slip -= operator.obstacle_weights @ motion
+        if operator.mass is not None:
+            slip = np.einsum("aik,ak->ai", operator.projectors,
+                             _solve_components(operator.mass, slip))
         weights = operator.weights * (self.penalty / self.normal_law.penalty)
         history = np.einsum("aik,ak->ai", operator.projectors, h.forces)
         trial = history + weights[:, None] * slip
-        mapping = self.law.return_mapping(trial, state.force, weights, active > 0)
+        # the cone's normal force ω⟨y⟩ (for GLS state.force is L⁻¹ of it)
+        normal = self.normal_law.force(state.weights, state.gaps)
+        mapping = self.law.return_mapping(trial, normal, weights, active > 0)
         G_T = operator.G_T.copy()
         if mask is not None:
             G_T.diagonalScale(None, mask)
         f = G_T.createVecLeft()
-        f.array[:] = mapping.force[: self.slave.layout.num_owned].ravel()
+        force = mapping.force
+        if operator.mass is not None:
+            # R_T = Ĝ_Tᵀ L⁻¹ P f_T, with P f_T = f_T
+            force = _solve_components(operator.mass, force)
+        f.array[:] = force[: self.slave.layout.num_owned].ravel()
         residual = G_T.createVecRight()
         G_T.multTranspose(f, residual)
         f.destroy()
@@ -288,8 +346,8 @@ class Friction:
         nodes = nodes[nodes < layout.num_owned]
         rows = nodes[:, None] * gdim + np.arange(gdim)
         if columns == "dofs":
-            return assemble_blocks(model.dofs, rows, model.dofs, model.node_dofs(nodes),
-                                   values[nodes])
+            dofs = layout.global_indices[nodes][:, None] * gdim + np.arange(gdim)
+            return assemble_blocks(model.dofs, rows, model.dofs, dofs, values[nodes])
         return assemble_blocks(model.dofs, rows, layout, layout.global_indices[nodes][:, None],
                                values[nodes][:, :, None])
 
@@ -297,6 +355,24 @@ class Friction:
                  active: FloatArray) -> PETSc.Mat:
         """``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ∂f_N/∂u)`` at ``friction``."""
         mapping = friction.mapping
+        return self._product(model, friction, self._tangent(mapping), mapping.normal_tangent,
+                             model.normal_force_derivative(state, active))
+
+    def augmented_blocks(self, model, state: ContactState, friction: FrictionState,
+                         active: FloatArray) -> AugmentedFriction:
+        """Friction's blocks of the GLS kinds' augmented Newton system at ``friction``."""
+        mapping = friction.mapping
+        P = self._operator.projectors
+        PCP = np.einsum("aij,ajk,akl->ail", P, self._tangent(mapping), P)
+        PB = np.einsum("aij,aj->ai", P, mapping.normal_tangent) * \
+            (state.weights * active)[:, None]
+        return AugmentedFriction(friction.G_T, self._node_blocks(model, PCP, "dofs"),
+                                 self._node_blocks(model, PB, "nodes"),
+                                 kron_identity(model.mass.matrix, self.slave.gdim))
+
+    def _tangent(self, mapping: ReturnMapping) -> FloatArray:
+        """The return mapping's tangent for Newton: the secant while the
+        stick/slip states change, then exact (collective)."""
         states = mapping.state
         # the exact slip tangent (0 along t in 2D) lets a slipping node's
         # direction flip in one Newton step across the tiny stick range μp/ε_T,
@@ -307,9 +383,7 @@ class Friction:
                                            and np.array_equal(states, self._jacobian_states)),
                                       op=MPI.LAND)
         self._jacobian_states = states.copy()
-        tangent = mapping.tangent if settled else mapping.secant_tangent()
-        return self._product(model, friction, tangent, mapping.normal_tangent,
-                             model.normal_force_derivative(state, active))
+        return mapping.tangent if settled else mapping.secant_tangent()
 
     def _product(self, model, friction: FrictionState, tangent: FloatArray,
                  normal_tangent: FloatArray, D: PETSc.Mat) -> PETSc.Mat:

@@ -103,7 +103,9 @@ class AugmentedEntry(AssembledEntry):
 
     def assemble(self, A: PETSc.Mat, model: GapModel, state: ContactState, active: FloatArray,
                  mask: PETSc.Vec, configuration, friction=None) -> bool:
-        self.step.update_from(A, state, model, active)
+        tangential = (friction.augmented_blocks(model, state, state.friction, active)
+                      if friction is not None else None)
+        self.step.update_from(A, state, model, active, tangential)
         return False
 
     def configure_ksp(self, ksp: PETSc.KSP) -> None:

@@ -153,7 +153,6 @@ def test_the_output_carries_the_tangential_traction_and_the_states(tmp_path_fact
 
 
 @pytest.mark.parametrize("options, message", [
-    ({"kind": "GLS"}, "global kinds"), ({"kind": "GLS*"}, "global kinds"),
     ({"active_set": "pointwise", "kind": "LmLS*"}, "pointwise")])
 def test_unsupported_combinations_say_why(options, message):
     V, tags = block_on_plane(n=(4, 2))

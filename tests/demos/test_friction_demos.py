@@ -31,7 +31,8 @@ SLIP_CASES = ([("0.2", "0.3", kind, "initial") for kind in LOCAL_KINDS]
                  pytest.param("0.2", "0.1", "LmLS", "previous", marks=CYCLES),
                  ("0.5", "0.3", "LmLS", "initial"), ("0.2", "0.3", "LcLS*", "current"),
                  ("0.0", "0.3", "LmLS", "current"), ("0.5", "0.3", "LmLS*", "current"),
-                 ("0.2", "0.1", "LcLS*", "current")])
+                 ("0.2", "0.1", "LcLS*", "current"), ("0.2", "0.3", "GLS", "initial"),
+                 ("0.5", "0.3", "GLS*", "initial"), ("0.2", "0.1", "GLS", "initial")])
 
 
 @pytest.mark.parametrize("tan_alpha, mu, kind, configuration", SLIP_CASES)
