@@ -173,13 +173,18 @@ class Holder:
     """The rigid holder of the upper body: it moves its flat face by (s, −δ)
     along x and the vertical without turning it, and finds the δ and s that
     make the contact carry P and Q (a body loaded by forces alone would roll).
-    ``share``: the modelled share of the body (½ for the half sphere)."""
+    ``share``: the modelled share of the body (½ for the half sphere);
+    ``force``: P, the scale of the absolute residual tolerance."""
 
-    def __init__(self, contact, problem, approach, shift, steps: int, share: float = 1.0):
+    def __init__(self, contact, problem, approach, shift, steps: int, share: float = 1.0,
+                 force: float = 1.0):
         from dolfinx_mortar import LoadPathSolver
         self.contact, self.approach, self.shift = contact, approach, shift
         self.share = share
-        self.solver = LoadPathSolver(problem)
+        # a secant correction is a step of about 1e-5 of the forces: 1e-8 of
+        # its own force fell below the residual's round-off with GLS*
+        # (3e-14, through L⁻¹), so 1e-10 of P is accepted too
+        self.solver = LoadPathSolver(problem, petsc_options={"snes_atol": 1e-10 * force})
         self.steps = steps
         self.newton_iterations = self.load_steps = self.cut_backs = 0
 
@@ -265,7 +270,7 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     clock = time.perf_counter()
     contact, problem, approach, shift, h = build(args, ref, comm)
     holder = Holder(contact, problem, approach, shift, args.load_steps,
-                    share=0.5 if args.geometry == "sphere" else 1.0)
+                    share=0.5 if args.geometry == "sphere" else 1.0, force=args.force)
     holder.reach(approach, 0, args.force, -ref["approach"])
     if args.tangential > 0:
         holder.steps = args.tangential_steps

@@ -130,3 +130,23 @@ class PatternTrackingAdd:
     def reset(self) -> None:
         """Forget the last pattern (the next add rebuilds ``A``'s pattern)."""
         self._rows = self._cols = None
+
+
+def kron_identity(L: PETSc.Mat, bs: int) -> PETSc.Mat:
+    """``L ⊗ I_bs`` (row and column i·bs + k from i), on the owned rows."""
+    indptr, cols, values = L.getValuesCSR()
+    n = len(indptr) - 1
+    counts = np.diff(indptr)
+    starts = np.zeros(n * bs + 1, dtype=PETSc.IntType)
+    starts[1:] = np.cumsum(np.repeat(counts, bs))
+    row = np.repeat(np.arange(n), counts)
+    within = np.arange(len(cols)) - indptr[row]
+    new_cols = np.empty(len(cols) * bs, dtype=PETSc.IntType)
+    new_values = np.empty(len(cols) * bs)
+    for k in range(bs):
+        at = starts[row * bs + k] + within
+        new_cols[at] = cols * bs + k
+        new_values[at] = values
+    (m, M), _ = L.getSizes()
+    return PETSc.Mat().createAIJ(size=((m * bs, M * bs), (m * bs, M * bs)),
+                                 csr=(starts, new_cols, new_values), comm=L.comm)

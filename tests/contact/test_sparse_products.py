@@ -1,5 +1,5 @@
 """Sparse products and adds of the contact stiffness (PatternTrackingAdd,
-TransposeProduct), on 1 and 2 ranks."""
+TransposeProduct, kron_identity), on 1 and 2 ranks."""
 from __future__ import annotations
 
 import numpy as np
@@ -7,7 +7,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.linalg.sparse_products import (PatternTrackingAdd, TransposeProduct,
-                                                     transpose_mat_mult)
+                                                     kron_identity, transpose_mat_mult)
 
 N = 40
 
@@ -169,3 +169,12 @@ def test_transpose_product_reuses_only_an_unchanged_pattern():
         assert np.max(np.abs(_dense(K) - expected)) <= 1e-14 * np.max(np.abs(expected))
         assert np.allclose(_dense(K), _dense(transpose_mat_mult(G, SG)), rtol=0,
                            atol=1e-14 * np.max(np.abs(expected)))
+
+
+def test_kron_identity_is_the_kronecker_product_with_the_identity():
+    """L ⊗ I_bs, the friction blocks' mass matrix of the GLS kinds (row i·bs + k)."""
+    entries = [(i, (3 * i + 7) % N, 1.0 + i) for i in range(N)] + [(i, i, 10.0) for i in range(N)]
+    L = _matrix(entries, 2)
+    for bs in (2, 3):
+        expected = np.kron(_dense_rectangular(L), np.eye(bs))
+        assert np.array_equal(_dense_rectangular(kron_identity(L, bs)), expected)

@@ -97,8 +97,12 @@ EDGE_NODE_CYCLES = pytest.mark.xfail(MPI.COMM_WORLD.size > 1, strict=False,
                                      reason="Newton cycles at a contact-edge node on 2 ranks")
 
 
-@pytest.mark.parametrize("kind", ["LmLS", "LmLS*", pytest.param("LcLS", marks=EDGE_NODE_CYCLES)])
-def test_cattaneo_mindlin_every_local_kind(kind):
+@pytest.mark.parametrize("kind", ["LmLS", "LmLS*", pytest.param("LcLS", marks=EDGE_NODE_CYCLES),
+                                  "GLS", "GLS*"])
+def test_cattaneo_mindlin_every_kind(kind):
+    """The other kinds than the default's (test above) at refine 0.5: the
+    dual and global kinds give LcLS*'s +2.3% and 4.5%, LmLS and LmLS* −4.8%
+    and 5.9%."""
     demo = load_demo("cattaneo_mindlin")
     f = demo.run(demo.parse_args(["--refine", "0.5", "--kind", kind]), MPI.COMM_WORLD)
     assert abs(f["c_error"]) < 0.06

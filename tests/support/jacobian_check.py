@@ -48,7 +48,7 @@ def jacobian_error(problem, rng_seed: int = 1) -> float:
     return fd.norm() / Jdx.norm()
 
 
-def newton_step_error(problem, rng_seed: int = 2) -> float:
+def newton_step_error(problem, rng_seed: int = 2, size: float = 1e-6) -> float:
     """‖R'(x)Δu − r‖/‖r‖ for the Newton step Δu the problem's own linear solve
     gives for a random r (the augmented system of the GLS kinds), R' by
     central differences, at the current u."""
@@ -64,7 +64,7 @@ def newton_step_error(problem, rng_seed: int = 2) -> float:
     problem.problem.configure_ksp(ksp)    # the exact step of the augmented system
     ksp.solve(r, du)
     ksp.destroy()
-    fd = residual_difference(problem, x0, du)
+    fd = residual_difference(problem, x0, du, size)
     fd.axpy(-1.0, r)
     return fd.norm() / r.norm()
 
