@@ -19,7 +19,13 @@ contact's normal nodal forces,
 
 - residual ``R_T = G_Tᵀ f_T`` with ``G_T = ∂Δy_T/∂u`` (linear: frozen
   normals and integrals within a step),
-- Jacobian ``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ωH G)``, unsymmetric in slip.
+- Jacobian ``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ∂f_N/∂u)``, unsymmetric in slip
+  (``∂f_N/∂u = ωH G`` on frozen bases).
+
+GLS and GLS* (gaps ``L⁻¹ĝ`` of the standard basis) measure the slip the same
+way through L: ``Δy_T = P L⁻¹(Ĝ_T Δu − (∫N) Δc)``, residual ``Ĝ_Tᵀ L⁻¹ f_T``;
+their dense tangent is never formed, the augmented Newton system carries it
+(:class:`AugmentedFriction`, :mod:`~dolfinx_mortar.contact.augmented`).
 
 On the current surface (``basis_configuration="current"``) the normal contact
 follows u and the slip is measured as above on the model frozen where the
