@@ -105,30 +105,22 @@ def second_2d(x):
     return np.vstack([0.0053 * (x[0] - 0.47), -0.00261 - 0.00397 * x[0]])
 
 
-@pytest.mark.parametrize("kind", LOCAL_KINDS)
+def obstacle_2d(name: str):
+    return RigidPlane([0, 0], [0, 1]) if name == "plane" else RigidSphere([0.5, -50.0], 50.0)
+
+
+@pytest.mark.parametrize("kind", LOCAL_KINDS + ["GLS", "GLS*"])
 @pytest.mark.parametrize("scaling", ["consistent", "seed"])
 @pytest.mark.parametrize("obstacle", ["plane", "disk"])
 def test_block_on_an_obstacle(kind, scaling, obstacle):
-    shape = (RigidPlane([0, 0], [0, 1]) if obstacle == "plane"
-             else RigidSphere([0.5, -50.0], 50.0))
-    check_both_branches(block(shape, kind, scaling), first_2d, second_2d)
-
-
-@pytest.mark.parametrize("kind", ["GLS", "GLS*"])
-@pytest.mark.parametrize("scaling", ["consistent", "seed"])
-@pytest.mark.parametrize("obstacle", ["plane", "disk"])
-def test_block_on_an_obstacle_global_kinds(kind, scaling, obstacle):
-    shape = (RigidPlane([0, 0], [0, 1]) if obstacle == "plane"
-             else RigidSphere([0.5, -50.0], 50.0))
-    check_both_branches(block(shape, kind, scaling), first_2d, second_2d)
+    check_both_branches(block(obstacle_2d(obstacle), kind, scaling), first_2d, second_2d)
 
 
 @pytest.mark.parametrize("kind", ["LcLS*", "LmLS"])
 @pytest.mark.parametrize("obstacle", ["plane", "disk"])
 def test_block_on_an_obstacle_current(kind, obstacle):
-    shape = (RigidPlane([0, 0], [0, 1]) if obstacle == "plane"
-             else RigidSphere([0.5, -50.0], 50.0))
-    check_both_branches(block(shape, kind, configuration="current"), first_2d, second_2d)
+    check_both_branches(block(obstacle_2d(obstacle), kind, configuration="current"),
+                        first_2d, second_2d)
 
 
 def on_the_axis(values):
