@@ -7,7 +7,7 @@ stiff only from the current gap on, creeps towards the obstacle.
 """
 from __future__ import annotations
 
-from typing import Optional
+from typing import Optional, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -44,22 +44,95 @@ def penetrates(model: GapModel, state: ContactState) -> bool:
     return bool(comm.allreduce(bool(np.any(deep)), op=MPI.LOR))
 
 
-def stiffened_nodes(model: GapModel, state: ContactState) -> FloatArray:
+def stiffened_nodes(model: GapModel, state: ContactState,
+                    near_contact: bool = True) -> FloatArray:
     """Nodes that get contact stiffness in the Jacobian (H(d̄) as 0/1).
 
     The generalized derivative of ⟨·⟩ at 0 is taken as 1, so touching nodes
-    stiffen without pushing. If no node on any rank penetrates
-    (:func:`penetrates`), the covered nodes within NEAR_CONTACT of their
-    element length of contact get stiffness too: otherwise the rigid-body
-    mode that the contact must hold makes the Jacobian singular. Once a node
+    stiffen without pushing. If ``near_contact`` and no node on any rank
+    penetrates (:func:`penetrates`), the covered nodes within NEAR_CONTACT of
+    their element length of contact get stiffness too: where only the contact
+    can hold the body, the rigid-body mode it must hold otherwise makes the
+    Jacobian singular (:class:`NearContactStiffness` says where). Once a node
     is active the Jacobian is exact again. Nodes with nothing below them have
     no gap and are never active.
     """
     covered = state.covered
     active = covered & PenaltyLaw.active(state.gaps)
-    if not penetrates(model, state):
+    if near_contact and not penetrates(model, state):
         active = covered & (state.gaps >= -NEAR_CONTACT * model.basis.node_lengths)
     return active.astype(np.float64)
+
+
+class NearContactStiffness:
+    """Whether the nodes near contact need stiffness while nothing touches.
+
+    Stiffness without force is right only where nothing but the contact can
+    hold the body: a force-controlled Hertz cylinder has a singular Jacobian
+    until a node penetrates. Where the bulk holds it (a block pushed by a
+    prescribed displacement, started a fraction of an element above the
+    plane), the stiffened matrix is ε·h/E times stiffer than the residual,
+    whose contact force is zero, and every Newton step is that much too
+    short: a load step that ended 0.02 h short of contact stalled (issue 35).
+
+    Which of the two holds is decided from the bulk, not guessed: the rigid
+    motions of the bodies that neither the Dirichlet conditions nor the
+    user's form resist (``free``, :meth:`NonlinearContactProblem.free_rigid_motions
+    <dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem.free_rigid_motions>`)
+    are the ones the contact must hold; the near nodes are stiffened only
+    if one of them changes their gaps. The decision holds until a node
+    penetrates or the next load step starts.
+    """
+
+    #: a free motion moves the near nodes' gaps when it changes one by more
+    #: than this fraction of the motion's largest displacement (round-off
+    #: is 1e-16 of it; a rotation about a point contact moves them by the
+    #: distance ratio, far above)
+    MOVES = 1e-8
+
+    def __init__(self) -> None:
+        #: None: not decided since the last contact; True: the bulk holds the
+        #: body (no stiffness without force); False: only the contact can
+        self.bulk_holds: Optional[bool] = None
+
+    def mask(self, model: GapModel, state: ContactState) -> FloatArray:
+        """:func:`stiffened_nodes`, with the near nodes stiffened unless the
+        bulk holds the body (collective)."""
+        if penetrates(model, state):
+            self.bulk_holds = None
+        return stiffened_nodes(model, state, near_contact=not self.bulk_holds)
+
+    def reset(self) -> None:
+        """Decide again at the next approach (a new load step)."""
+        self.bulk_holds = None
+
+    def due(self, model: GapModel, state: ContactState) -> bool:
+        """Whether a decision is due: nothing penetrates, some node is near
+        contact, nothing decided yet (collective)."""
+        if self.bulk_holds is not None or penetrates(model, state):
+            return False
+        n = model.slave.layout.num_owned
+        near = stiffened_nodes(model, state)[:n]
+        return model.slave.layout.comm.allreduce(int(np.sum(near))) > 0
+
+    def decide(self, model: GapModel, state: ContactState,
+               free: Sequence[PETSc.Vec]) -> bool:
+        """Record whether the bulk holds the body: no ``free`` rigid motion
+        (dof vectors) changes a near node's gap; returns it (collective)."""
+        layout = model.slave.layout
+        n = layout.num_owned
+        near = stiffened_nodes(model, state)[:n] > 0
+        moves = False
+        for motion in free:
+            change = state.G.createVecLeft()
+            state.G.mult(motion, change)
+            # the gaps' change: G r for the local kinds, L⁻¹ Ĝ r for GLS
+            gaps = model.nodal_force(layout.to_local(change))[:n]
+            largest = layout.comm.allreduce(float(np.max(np.abs(gaps[near]), initial=0.0)),
+                                            op=MPI.MAX)
+            moves |= largest > self.MOVES * motion.norm(PETSc.NormType.NORM_INFINITY)
+        self.bulk_holds = not moves
+        return self.bulk_holds
 
 
 def gap_closing_force(model: GapModel, state: ContactState) -> Optional[PETSc.Vec]:

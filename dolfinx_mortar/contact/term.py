@@ -28,7 +28,7 @@ from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.active_set import gap_closing_force, stiffened_nodes
+from dolfinx_mortar.contact.active_set import NearContactStiffness, gap_closing_force
 from dolfinx_mortar.contact.checks import RangeChecks
 from dolfinx_mortar.contact.configuration import configuration_of
 from dolfinx_mortar.contact.friction import Friction
@@ -149,6 +149,7 @@ class ContactTerm:
         self.checks = RangeChecks(self)
         #: Coulomb friction and its history (None: frictionless)
         self.friction: Optional[Friction] = None
+        self._near_contact = NearContactStiffness()
         if friction is not None:
             step_start = None
             if self.configuration.follows_u:
@@ -184,6 +185,7 @@ class ContactTerm:
         since they were built; returns True then (the contact pattern may have
         changed: :meth:`create_matrix` again).
         """
+        self._near_contact.reset()
         model = self._timed_build(self.configuration.begin_step, self.options)
         if model is None:
             return False
@@ -334,13 +336,27 @@ class ContactTerm:
         return A
 
     def active_nodes_mask(self, state: ContactState) -> FloatArray:
-        """Nodes that get contact stiffness (H(d̄) as 0/1,
-        :func:`~dolfinx_mortar.contact.active_set.stiffened_nodes`)."""
-        return stiffened_nodes(self.model, state)
+        """Nodes that get contact stiffness (H(d̄) as 0/1, and the nodes near
+        contact where the bulk cannot hold the body:
+        :class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`)."""
+        return self._near_contact.mask(self.model, state)
+
+    def settle_near_contact(self, free_motions) -> None:
+        """Where nothing touches yet and some node is near contact, decide
+        whether those nodes need stiffness without force: only if one of the
+        bodies' ``free_motions`` (a callable giving the rigid motions that
+        the bulk does not resist, as dof vectors) changes their gaps
+        (:class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`;
+        collective)."""
+        if self.state is not None and self._near_contact.due(self.model, self.state):
+            self._near_contact.decide(self.model, self.state, free_motions())
 
     def gap_closing_force(self) -> Optional[PETSc.Vec]:
         """The pull that closes the gaps near contact when nothing touches yet
+        and only the contact can hold the body
         (:func:`~dolfinx_mortar.contact.active_set.gap_closing_force`)."""
+        if self._near_contact.bulk_holds:
+            return None
         return gap_closing_force(self.model, self.state)
 
     def _add(self, name: str, since: float) -> None:

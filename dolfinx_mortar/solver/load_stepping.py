@@ -4,10 +4,18 @@ Halving a failed step and never growing it back again kept the halved step to
 the end of the run (34 steps instead of 6; a sliding run took 528 instead of
 20). :class:`LoadStepper` doubles the step after ``grow_after`` successes in a
 row, up to the step the user asked for, and lands exactly on load factor 1.
+
+Every run ends: a step is never cut below ``2^-max_cuts`` of the requested
+one, and the failed attempts of a whole run are counted too. Successes
+between failures used to reset the count, so a step that failed five times,
+succeeded once at 1/32 and failed again was cut to 1/1024, and so on without
+end: 1,114 failed attempts in 100 s with the load factor stuck at 0.159763
+(issue 35).
 """
 from __future__ import annotations
 
 import numbers
+from typing import Optional
 
 import numpy as np
 
@@ -36,21 +44,32 @@ class LoadStepper:
     grow_after
         Successes in a row after which a cut step is doubled (never beyond
         ``1 / load_steps``).
+    max_failures
+        Failed attempts allowed over the whole run (default: ``2·max_cuts +
+        load_steps``); one more means the load cannot be reached.
 
     Use: ``target = stepper.target()``, solve at it, then
     ``stepper.succeeded()`` or ``stepper.failed()``, while ``not stepper.done``.
     """
 
-    def __init__(self, load_steps: int, max_cuts: int = 5, grow_after: int = 2):
+    def __init__(self, load_steps: int, max_cuts: int = 5, grow_after: int = 2,
+                 max_failures: Optional[int] = None):
         self.load_steps = check_load_steps(load_steps)
-        if max_cuts < 0:
-            raise ValueError(f"max_cuts must be at least 0, got {max_cuts!r}")
+        if (isinstance(max_cuts, bool) or not isinstance(max_cuts, numbers.Integral)
+                or max_cuts < 0):
+            raise ValueError(f"max_cuts must be an integer of at least 0, got {max_cuts!r}")
         self.full_step = 1.0 / self.load_steps
         self.step = self.full_step
+        #: the smallest step a cut may make
+        self.min_step = self.full_step * 0.5 ** max_cuts
         self.max_cuts = max_cuts
         self.grow_after = grow_after
+        self.max_failures = (2 * max_cuts + self.load_steps if max_failures is None
+                             else max_failures)
         self.reached = 0.0
         self.failures = 0
+        #: failed attempts over the whole run
+        self.total_failures = 0
         self.successes = 0
         # a target this close to 1 is 1: far below the smallest step the cuts
         # can reach, above the round-off of the sum of the steps
@@ -63,8 +82,11 @@ class LoadStepper:
 
     @property
     def exhausted(self) -> bool:
-        """Whether more than ``max_cuts`` failures came in a row."""
-        return self.failures > self.max_cuts
+        """Whether the load cannot be reached: more than ``max_cuts`` failures
+        in a row, a failure at the smallest step, or more than
+        ``max_failures`` in all."""
+        return (self.failures > self.max_cuts or self.step < self.min_step
+                or self.total_failures > self.max_failures)
 
     def target(self) -> float:
         """The load factor of the next attempt; exactly 1.0 for the last step."""
@@ -82,8 +104,10 @@ class LoadStepper:
         return self.reached
 
     def failed(self) -> None:
-        """Record that :meth:`target` was not reached: halve the step."""
+        """Record that :meth:`target` was not reached: halve the step (the
+        next target is always a smaller load factor)."""
         self.failures += 1
+        self.total_failures += 1
         self.successes = 0
         self.step /= 2
 

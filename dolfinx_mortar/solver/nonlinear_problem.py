@@ -36,6 +36,11 @@ from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 
 
+#: a rigid motion that the bulk matrix resists by less than this fraction of
+#: its own scale is free (only the contact can hold it)
+FREE_MOTION = 1e-6
+
+
 class NonlinearContactProblem:
     """Residual ``F(u; v) + R_c(u)`` and its exact Jacobian.
 
@@ -188,6 +193,16 @@ class NonlinearContactProblem:
         fem_petsc.assemble_matrix(A, self.a, self.bcs)
         A.assemble()
         self._add("bulk_jacobian", clock)
+        free: list[list[PETSc.Vec]] = []
+
+        def free_motions() -> list[PETSc.Vec]:
+            # measured once, and before any contact stiffness is in A
+            if not free:
+                free.append(self.free_rigid_motions(A))
+            return free[0]
+
+        for term in self.contacts:
+            term.settle_near_contact(free_motions)
         for term in self.contacts:
             term.assemble_jacobian(A, self.bcs)
         if ksp is not None and any(term.pattern_changed for term in self.contacts):
@@ -213,6 +228,38 @@ class NonlinearContactProblem:
             from dolfinx_mortar.linalg.near_nullspace import rigid_body_modes
             self._near_nullspace = rigid_body_modes(self.u.function_space)
         return self._near_nullspace
+
+    def free_rigid_motions(self, A: PETSc.Mat) -> list[PETSc.Vec]:
+        """The rigid motions of the bodies that the bulk matrix ``A`` (with
+        the Dirichlet rows) does not resist: an orthonormal basis of the
+        combinations ``r`` of :meth:`near_nullspace`'s (orthonormal) modes
+        with ``|A r| ≤ FREE_MOTION·|A|`` (a Dirichlet row counts ``r`` at its
+        dof, at A's scale; a spring in the user's form counts as it
+        stiffens). Collective."""
+        modes = list(self.near_nullspace().getVecs())
+        scale = A.norm(PETSc.NormType.NORM_INFINITY)
+        free_dofs = self.contacts[0].mask(self.bcs).array_r
+        images = []
+        for r in modes:
+            y = A.createVecLeft()
+            A.mult(r, y)
+            # a Dirichlet row's 1 on the diagonal: what the mode moves there, at A's scale
+            y.array[:] = np.where(free_dofs > 0.5, y.array_r, scale * r.array_r)
+            images.append(y)
+        gram = np.array([[a.dot(b) for b in images] for a in images]) / scale ** 2
+        values, vectors = np.linalg.eigh(gram)
+        free = []
+        for value, c in zip(values, vectors.T):
+            # |A r| below 1e-6 of A's scale: the Gram matrix squares it, and
+            # its eigenvalues are exact to 1e-16 of the largest (about 1)
+            if value > FREE_MOTION ** 2:
+                continue
+            motion = modes[0].duplicate()
+            motion.set(0.0)
+            for ck, r in zip(c, modes):
+                motion.axpy(ck, r)
+            free.append(motion)
+        return free
 
     def contact_rows(self) -> np.ndarray:
         """Global indices of this rank's rows that the contact terms stiffened
