@@ -47,8 +47,13 @@ class EquilibriumTest:
     When Newton stagnates — its step is at round-off (``‖Δu‖ ≤ stol·‖u‖``) or
     it stalls (below) — the residual is at the floor that double precision
     allows for this problem: that floor is accepted as equilibrium when
-    ``‖R‖ ≤ floor_rtol·F``, and the solve fails, with the cause in words,
-    otherwise. (An elastic master at ε = 1e3 E/h stagnates at 3e-11 F; at
+    ``‖R‖ ≤ floor_rtol·max(F, S, C)``, with S the largest force a step of the
+    path started with (:attr:`force_scale`) and C the norm of the contact
+    forces carried where the solve started (:attr:`carried`): the round-off
+    of the forces already carried, which a small step cannot go below
+    (Cattaneo–Mindlin on the current surface reached 1.7e-15 = 1.4e-8 of its
+    step's F and was cut back again and again); the solve fails, with the
+    cause in words, otherwise. (An elastic master at ε = 1e3 E/h stagnates at 3e-11 F; at
     ε = 1e12 E/h a block on a tilted plane stagnates at 3e-5 F.)
 
     Parameters
@@ -82,6 +87,8 @@ class EquilibriumTest:
         self.cause: Optional[str] = None
         #: the largest out-of-balance force a step of the path started with
         self.force_scale = 0.0
+        #: the contact forces carried where the present solve started
+        self.carried = 0.0
 
     def step_reference(self, out_of_balance: float) -> float:
         """The force F of a load step that starts ``out_of_balance``: that force,
@@ -93,10 +100,12 @@ class EquilibriumTest:
         self.force_scale = max(self.force_scale, out_of_balance)
         return out_of_balance
 
-    def start(self, reference: Optional[float]) -> None:
+    def start(self, reference: Optional[float], carried: float = 0.0) -> None:
         """A new Newton solve; ``reference`` is the force ``F`` of ``‖R‖ ≤ rtol·F``
-        (None, also without a call: the first residual of each solve, PETSc's own rule)."""
+        (None, also without a call: the first residual of each solve, PETSc's own rule);
+        ``carried``, the norm of the contact forces already carried where it starts."""
         self._given = None if reference is None else float(reference)
+        self.carried = float(carried)
         self.norms = []
         self.cause = None
 
@@ -133,10 +142,16 @@ class EquilibriumTest:
                               "active set does not settle")
                 return _SNES.DIVERGED_DTOL
         if stagnation is not None:
-            if fnorm <= self.floor_rtol * self.reference:
+            # the floor of double precision is the whole problem's: a step
+            # whose increment is small (a tangential load after the normal
+            # one) stagnates at round-off of the forces already carried
+            floor = self.floor_rtol * max(self.reference, self.force_scale, self.carried)
+            if fnorm <= floor:
                 return accepted
             self.cause = (f"{stagnation}, |R| = {fnorm:.3e} = {self._relative(fnorm)} of the "
-                          f"reference force {self.reference:.3e} (accepted: {self.floor_rtol:g}): "
+                          f"reference force {self.reference:.3e} (accepted: {self.floor_rtol:g} "
+                          f"of it, or of the forces carried, "
+                          f"{max(self.force_scale, self.carried):.3e}): "
                           "Newton cannot reduce the residual further (a cycling active set, "
                           "or an ill-conditioned Newton matrix, e.g. a penalty far above E/h)")
             return _SNES.DIVERGED_DTOL

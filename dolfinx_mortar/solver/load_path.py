@@ -324,7 +324,7 @@ class LoadPathSolver:
         b = self.problem.vector()
         self.problem.F(x, b)
         reference = self.equilibrium.step_reference(b.norm())
-        self.equilibrium.start(reference)
+        self.equilibrium.start(reference, self.problem.carried_force())
         if increment is not None:
             x.axpy(1.0, increment)
             self.problem.F(x, b)

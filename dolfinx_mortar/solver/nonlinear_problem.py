@@ -229,6 +229,17 @@ class NonlinearContactProblem:
             self._near_nullspace = rigid_body_modes(self.u.function_space)
         return self._near_nullspace
 
+    def carried_force(self) -> float:
+        """The norm of the contact terms' residual at the last :meth:`F`: the
+        forces the contact carries, the scale of its round-off (collective)."""
+        states = [term.state for term in self.contacts if term.state is not None]
+        if not states:
+            return 0.0
+        total = states[0].residual.copy()
+        for state in states[1:]:
+            total.axpy(1.0, state.residual)
+        return total.norm()
+
     def free_rigid_motions(self, A: PETSc.Mat) -> list[PETSc.Vec]:
         """The rigid motions of the bodies that the bulk matrix ``A`` (with
         the Dirichlet rows) does not resist: an orthonormal basis of the
