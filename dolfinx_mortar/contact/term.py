@@ -41,7 +41,8 @@ from dolfinx_mortar.contact.state import ContactState, GapModel
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.input_checks import (check_cells, check_contact_arguments,
-                                         check_contact_tags)
+                                         check_contact_tags, collective_checks,
+                                         communicator_of)
 from dolfinx_mortar.surfaces.facet_surface import facet_surface
 
 FloatArray = npt.NDArray[np.float64]
@@ -114,13 +115,16 @@ class ContactTerm:
                  boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, axisymmetric: bool = False,
                  friction: Optional[CoulombFriction] = None):
-        check_contact_arguments(u, master_tag, obstacle, axisymmetric)
-        if friction is not None and not isinstance(friction, CoulombFriction):
-            raise TypeError(f"friction must be a CoulombFriction or None, got "
-                            f"{type(friction).__name__}")
-        options = ContactOptions.checked(kind, penalty, scaling, active_set,
-                                         basis_configuration, boundary_modification,
-                                         search_radius, master_tag is not None, axisymmetric)
+        # one decision of all ranks: an argument bad on one rank only raises on every rank
+        with collective_checks(communicator_of(u)):
+            check_contact_arguments(u, master_tag, obstacle, axisymmetric)
+            if friction is not None and not isinstance(friction, CoulombFriction):
+                raise TypeError(f"friction must be a CoulombFriction or None, got "
+                                f"{type(friction).__name__}")
+            options = ContactOptions.checked(kind, penalty, scaling, active_set,
+                                             basis_configuration, boundary_modification,
+                                             search_radius, master_tag is not None,
+                                             axisymmetric)
         V = u.function_space
         mesh = V.mesh
         check_cells(mesh)

@@ -22,7 +22,8 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.friction_law import CoulombFriction
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.term import ContactTerm
-from dolfinx_mortar.input_checks import check_boundary_data, check_tags
+from dolfinx_mortar.input_checks import (check_boundary_data, check_tags, collective_checks,
+                                         communicator_of)
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.small_strain.axisymmetric import axisymmetric_elastic_residual, circumference
 from dolfinx_mortar.solver.load_path import LoadPathSolver, SolveResult, StepResult
@@ -84,17 +85,19 @@ class ContactProblem:
                  search_radius: Optional[float] = None, petsc_options: Optional[dict] = None,
                  axisymmetric: bool = False, linear_solver: str = "auto",
                  friction: Optional[CoulombFriction] = None):
-        mesh = V.mesh
-        gdim = mesh.geometry.dim
-        if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
-            raise ValueError(f"need a finite E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
-        if nu > NEARLY_INCOMPRESSIBLE and V.ufl_element().degree == 1:
-            warnings.warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
-                          "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the contact "
-                          "force of nu = 0.3); use quadratic elements or a mixed form",
-                          RuntimeWarning, stacklevel=2)
-        fixed, tractions = fixed or {}, tractions or {}
-        check_boundary_data(fixed, tractions, gdim)
+        # one decision of all ranks: an argument bad on one rank only raises on every rank
+        with collective_checks(communicator_of(V)):
+            mesh = V.mesh
+            gdim = mesh.geometry.dim
+            if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
+                raise ValueError(f"need a finite E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
+            if nu > NEARLY_INCOMPRESSIBLE and V.ufl_element().degree == 1:
+                warnings.warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
+                              "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the "
+                              "contact force of nu = 0.3); use quadratic elements or a "
+                              "mixed form", RuntimeWarning, stacklevel=2)
+            fixed, tractions = fixed or {}, tractions or {}
+            check_boundary_data(fixed, tractions, gdim)
         check_tags(mesh, facet_tags, [*fixed, *tractions])
         self.V, self.mesh, self.facet_tags = V, mesh, facet_tags
         self.u = fem.Function(V, name="displacement")
