@@ -40,10 +40,11 @@ from dolfinx_mortar.contact.results import ContactResults
 from dolfinx_mortar.contact.state import ContactState, GapModel
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.kinds import KindLike
+from dolfinx_mortar.contact.setup_checks import (check_initial_overlap,
+                                                 check_obstacle_faces_slave,
+                                                 check_penalty_represents_a_force)
 from dolfinx_mortar.input_checks import (check_cells, check_contact_arguments,
-                                         check_contact_tags, check_initial_overlap,
-                                         check_obstacle_faces_slave,
-                                         check_penalty_represents_a_force, collective_checks,
+                                         check_contact_tags, collective_checks,
                                          communicator_of)
 from dolfinx_mortar.surfaces.facet_surface import facet_surface
 

@@ -159,7 +159,7 @@ def merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b, comm: Optional[MPI.
         # name b's values as the user wrote them, not only as shifted
         written = (f" (mesh_b's {[v - int(tag_offset) for v in clash]} shifted by tag_offset "
                    f"{tag_offset})" if tag_offset else "")
-        raise ValueError(f"facet tag values {clash}{written} mark facets of both meshes; pass "
+        raise ValueError(f"facet tag values {clash} mark facets of both meshes{written}; pass "
                          "tag_offset= to shift mesh_b's values, or list the values in "
                          "shared_tags= if they are meant to mark both bodies")
 

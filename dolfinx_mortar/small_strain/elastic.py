@@ -22,8 +22,9 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.friction_law import CoulombFriction
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.term import ContactTerm
-from dolfinx_mortar.input_checks import (check_boundary_data, check_penalty_against_stiffness,
-                                         check_tags, collective_checks, communicator_of)
+from dolfinx_mortar.contact.setup_checks import check_penalty_against_stiffness
+from dolfinx_mortar.input_checks import (check_boundary_data, check_tags, collective_checks,
+                                         communicator_of)
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.small_strain.axisymmetric import axisymmetric_elastic_residual, circumference
 from dolfinx_mortar.solver.load_path import LoadPathSolver, SolveResult, StepResult

@@ -82,6 +82,7 @@ def test_a_two_mesh_master_tag_is_named_as_written():
     with pytest.raises(ValueError, match=r"master_tag 7 of mesh_b: facet tag 7 marks no "
                                          r"facets \(tags present: \[4, 5, 6\]\)"):
         _two_blocks(0.0, master_tag=7, tag_offset=10, fixed={14: {0: 0.0, 1: 0.0}})
-    with pytest.raises(ValueError, match=r"facet tag values \[1, 2, 3\] \(mesh_b's \[4, 5, "
-                                         r"6\] shifted by tag_offset -3\) mark facets of both"):
+    with pytest.raises(ValueError, match=r"facet tag values \[1, 2, 3\] mark facets of both "
+                                         r"meshes \(mesh_b's \[4, 5, 6\] shifted by "
+                                         r"tag_offset -3\)"):
         _two_blocks(0.0, tag_offset=-3)
