@@ -143,7 +143,8 @@ def check_boundary_data(fixed: dict, tractions: dict, gdim: int) -> None:
 
 
 def check_cells(mesh: dolfinx.mesh.Mesh) -> None:
-    """Refuse cells of zero size and tangled (folded) cells.
+    """Refuse NaN or infinite node coordinates, cells of zero size and tangled
+    (folded) cells, on every rank (collective).
 
     Across every facet that two local cells share, their centroids must lie
     on opposite sides of the facet, each further than the zero length
@@ -155,7 +156,7 @@ def check_cells(mesh: dolfinx.mesh.Mesh) -> None:
     Raises
     ------
     ValueError
-        Naming the two cells and the facet's vertices.
+        Naming a non-finite node, or the two cells and the facet's vertices.
     """
     with collective_checks(mesh.comm):
         _check_finite_coordinates(mesh)

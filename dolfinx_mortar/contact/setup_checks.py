@@ -1,10 +1,12 @@
 """Checks of a contact term's set-up against its geometry, made where the term
-is made: an obstacle facing into the slave body, bodies overlapping at the
-start, a penalty that cannot represent a force or is far below E/h. Each is
-collective and names the cause (they were Newton failures blamed on the load
-or on a master out of reach).
+is made: an obstacle facing into the slave body (warned about), bodies
+overlapping at the start, a penalty that cannot represent a force or is far
+below E/h (refused). Each is collective and names the cause (they were Newton
+failures blamed on the load or on a master out of reach).
 """
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 from mpi4py import MPI
@@ -15,17 +17,13 @@ from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
 
-def check_obstacle_faces_slave(obstacle, slave, comm: MPI.Comm) -> None:
-    """Refuse an obstacle whose outward normal (the gradient of its signed
-    distance) nowhere faces the slave surface's outward normal: it points
-    into the slave body (a RigidPlane with its normal flipped), and nothing
-    can ever touch. It was reported as Newton "stalled" with nothing in
-    reach (collective).
-
-    Raises
-    ------
-    ValueError
-        Naming the obstacle, on every rank.
+def warn_if_the_obstacle_faces_away(obstacle, slave, comm: MPI.Comm) -> None:
+    """Warn when an obstacle's outward normal (the gradient of its signed
+    distance) nowhere faces the slave surface's outward normal: it points into
+    the slave body (a RigidPlane with its normal flipped), and nothing can
+    ever touch. It was reported as Newton "stalled" with nothing in reach
+    (collective). A warning, as for a master facing away
+    (:meth:`~dolfinx_mortar.contact.checks.RangeChecks.warn_if_no_master_is_in_reach`).
     """
     facing = False
     if len(slave.cells):
@@ -36,12 +34,12 @@ def check_obstacle_faces_slave(obstacle, slave, comm: MPI.Comm) -> None:
         # unit vectors: facing where they point against each other at all
         facing = bool(np.any(np.einsum("cng,cng->cn", normals, outward) < 0))
     if not comm.allreduce(facing, op=MPI.LOR):
-        raise ValueError(f"the obstacle {obstacle!r} faces away from the slave surface: at "
-                         "every slave node its outward normal points the same way as the "
-                         "slave's outward normal (or across it), so the obstacle's normal "
-                         "points into the slave body and nothing can touch it. The "
-                         "obstacle's normal must point out of the obstacle, towards the "
-                         "body (for a RigidPlane: flip its normal)")
+        warnings.warn(f"the obstacle {obstacle!r} faces away from the slave surface: at "
+                      "every slave node its outward normal points the same way as the "
+                      "slave's outward normal (or across it), so the obstacle's normal "
+                      "points into the slave body and nothing can touch it. The obstacle's "
+                      "normal must point out of the obstacle, towards the body (for a "
+                      "RigidPlane: flip its normal)", RuntimeWarning, stacklevel=3)
 
 
 #: how many times the search radius a check of an initial overlap looks

@@ -41,8 +41,8 @@ from dolfinx_mortar.contact.state import ContactState, GapModel
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.contact.setup_checks import (check_initial_overlap,
-                                                 check_obstacle_faces_slave,
-                                                 check_penalty_represents_a_force)
+                                                 check_penalty_represents_a_force,
+                                                 warn_if_the_obstacle_faces_away)
 from dolfinx_mortar.input_checks import (check_cells, check_contact_arguments,
                                          check_contact_tags, collective_checks,
                                          communicator_of)
@@ -138,8 +138,6 @@ class ContactTerm:
         self.master = (facet_surface(V, facet_tags, master_tag, axisymmetric=axisymmetric)
                        if master_tag is not None else None)
         check_penalty_represents_a_force(options.penalty, self.slave, mesh.comm)
-        if obstacle is not None:
-            check_obstacle_faces_slave(obstacle, self.slave, mesh.comm)
         #: the checked options (kind, penalty law, configuration, …)
         self.options = options
         #: where the bases live and when they move
@@ -167,6 +165,8 @@ class ContactTerm:
             self.friction = Friction(friction, options, u, self.slave, obstacle, step_start)
         self.model: GapModel = self._timed_build(self.configuration.build, options)
         self.checks.warn_deep_initial_penetration()
+        if obstacle is not None:
+            warn_if_the_obstacle_faces_away(obstacle, self.slave, mesh.comm)
         coupling = self.configuration.segmentation(self.model)
         check_initial_overlap(self, coupling)
         self.checks.warn_if_no_master_is_in_reach(coupling)
