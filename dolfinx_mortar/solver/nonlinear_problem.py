@@ -32,8 +32,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
-from dolfinx_mortar.input_checks import (collective_checks, communicator_of, load_data,
-                                         non_finite_input)
+from dolfinx_mortar.input_checks import checked_contact_terms, load_data, non_finite_input
 from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 
@@ -74,21 +73,7 @@ class NonlinearContactProblem:
         self.petsc_options = dict(petsc_options or {})
         self._snes: Optional[PETSc.SNES] = None
         self.bcs = list(bcs)
-        # one decision of all ranks: an argument bad on one rank only raises on every rank
-        with collective_checks(communicator_of(u)):
-            self.contacts = [contact] if isinstance(contact, ContactTerm) else list(contact)
-            if not self.contacts:
-                raise ValueError("no contact term: use dolfinx.fem.petsc.NonlinearProblem")
-            for term in self.contacts:
-                if not isinstance(term, ContactTerm):
-                    raise TypeError(f"contact terms must be ContactTerms, got "
-                                    f"{type(term).__name__}")
-                if term.u is not u:
-                    raise ValueError("every contact term must be built on the problem's u")
-            if len(self.contacts) > 1 and any(term.entry.takes_the_linear_solve
-                                              for term in self.contacts):
-                raise NotImplementedError("a GLS kind (augmented Newton step) must be the "
-                                          "only contact term of a problem")
+        self.contacts = checked_contact_terms(u, contact)
         fc = form_compiler_options or {}
         jit = jit_options or {}
         self.L = fem.form(F, form_compiler_options=fc, jit_options=jit)
