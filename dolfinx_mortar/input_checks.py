@@ -5,15 +5,133 @@ not later inside FFCx, the compiler or MUMPS.
 """
 from __future__ import annotations
 
+import builtins
 import ctypes
-from typing import Callable, Iterable, Optional
+import importlib
+from contextlib import contextmanager
+from typing import Callable, Iterable, Iterator, Optional, Sequence
 
 import dolfinx
 import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import dolfinx_compat
 from dolfinx_mortar.tolerance import length_scale, zero_length
+
+
+@contextmanager
+def collective_checks(comm: MPI.Comm) -> Iterator[None]:
+    """Make the checks in the block one decision of all ranks of ``comm``.
+
+    The block must not communicate. If it raises on any rank, every rank
+    raises: the rank that failed first (lowest rank) raises its own
+    exception, the others an exception of the same type with the same
+    message. A check that failed on one rank only (a NaN penalty on rank 1)
+    used to raise there while the other ranks went on into the next
+    collective and waited for ever. Collective: every rank must enter the
+    block.
+    """
+    failure: Optional[BaseException] = None
+    try:
+        yield
+    except Exception as error:      # noqa: BLE001 - re-raised below, on every rank
+        failure = error
+    first = comm.allreduce(comm.rank if failure is not None else comm.size, op=MPI.MIN)
+    if first == comm.size:
+        return
+    kind = (type(failure).__module__, type(failure).__qualname__, str(failure)) \
+        if comm.rank == first else None
+    module, name, message = comm.bcast(kind, root=first)
+    if comm.rank == first:
+        raise failure
+    raise _exception_like(module, name, message)
+
+
+def communicator_of(u) -> MPI.Comm:
+    """The communicator of the mesh of ``u`` (a Function or a function space);
+    ``MPI.COMM_WORLD`` for anything else, so that the checks that refuse it are
+    collective too."""
+    space = getattr(u, "function_space", u)
+    comm = getattr(getattr(space, "mesh", None), "comm", None)
+    return comm if isinstance(comm, MPI.Comm) else MPI.COMM_WORLD
+
+
+def _exception_like(module: str, name: str, message: str) -> BaseException:
+    """An exception of the class ``module.name`` with ``message`` (a RuntimeError
+    naming the class where it cannot be made from a message alone)."""
+    try:
+        cls = getattr(builtins if module == "builtins" else importlib.import_module(module),
+                      name)
+        return cls(message)
+    except Exception:               # noqa: BLE001 - a class that takes other arguments
+        return RuntimeError(f"{module}.{name} on another rank: {message}")
+
+
+def checked_contact_terms(u, contact) -> list:
+    """The contact term or terms given to a
+    :class:`~dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem`
+    on ``u``, as a list, checked on every rank together (collective)."""
+    from dolfinx_mortar.contact.term import ContactTerm     # it imports this module
+    with collective_checks(communicator_of(u)):
+        contacts = [contact] if isinstance(contact, ContactTerm) else list(contact)
+        if not contacts:
+            raise ValueError("no contact term: use dolfinx.fem.petsc.NonlinearProblem")
+        for term in contacts:
+            if not isinstance(term, ContactTerm):
+                raise TypeError(f"contact terms must be ContactTerms, got "
+                                f"{type(term).__name__}")
+            if term.u is not u:
+                raise ValueError("every contact term must be built on the problem's u")
+        if len(contacts) > 1 and any(term.entry.takes_the_linear_solve for term in contacts):
+            raise NotImplementedError("a GLS kind (augmented Newton step) must be the only "
+                                      "contact term of a problem")
+    return contacts
+
+
+def load_data(forms: Sequence, u, bcs: Sequence) -> list[tuple[str, Callable]]:
+    """What a load path may set in the user's model, each with a description and
+    a function that returns its present local values: the Constants and the
+    Functions other than ``u`` of the UFL ``forms``, and the values of the
+    Dirichlet conditions ``bcs``."""
+    data: list[tuple[str, Callable]] = []
+    constants = {id(c): c for form in forms for c in form.constants()}
+    for k, c in enumerate(constants.values()):
+        data.append((f"Constant {k} of the residual form", lambda c=c: c.value))
+    coefficients = {id(f): f for form in forms for f in form.coefficients() if f is not u}
+    for f in coefficients.values():
+        name = getattr(f, "name", "")
+        data.append((f"the Function '{name}' of the residual form",
+                     lambda f=f: f.x.array))
+    for k, bc in enumerate(bcs):
+        g = bc.g
+        data.append((f"the value of Dirichlet condition {k}",
+                     (lambda g=g: g.value) if hasattr(g, "value") else (lambda g=g: g.x.array)))
+    return data
+
+
+def non_finite_input(comm: MPI.Comm, x: PETSc.Vec,
+                     data: Sequence[tuple[str, Callable]]) -> tuple[bool, Optional[str]]:
+    """Whether the iterate ``x`` is finite, and what in it or in the model's
+    ``data`` (:func:`load_data`) is NaN or infinite (None: nothing), the same
+    on every rank (collective)."""
+    message = None
+    for description, values in data:
+        v = np.asarray(values())
+        if not np.all(np.isfinite(v)):
+            shown = v.tolist() if v.size <= 3 else "an array"
+            message = (f"{description} is NaN or infinite ({shown}): the residual is not "
+                       "finite after the load update; the load path (its update(t)) set a "
+                       "non-finite load")
+            break
+    finite = bool(np.all(np.isfinite(x.array_r)))
+    gathered = comm.allgather((finite, message))
+    iterate_finite = all(f for f, _ in gathered)
+    messages = [m for _, m in gathered if m]
+    if messages:
+        return iterate_finite, messages[0]
+    return iterate_finite, (None if iterate_finite
+                            else "the Newton iterate has NaN or infinite values")
 
 
 def check_boundary_data(fixed: dict, tractions: dict, gdim: int) -> None:
@@ -46,7 +164,8 @@ def check_boundary_data(fixed: dict, tractions: dict, gdim: int) -> None:
 
 
 def check_cells(mesh: dolfinx.mesh.Mesh) -> None:
-    """Refuse cells of zero size and tangled (folded) cells.
+    """Refuse NaN or infinite node coordinates, cells of zero size and tangled
+    (folded) cells, on every rank (collective).
 
     Across every facet that two local cells share, their centroids must lie
     on opposite sides of the facet, each further than the zero length
@@ -58,13 +177,27 @@ def check_cells(mesh: dolfinx.mesh.Mesh) -> None:
     Raises
     ------
     ValueError
-        Naming the two cells and the facet's vertices.
+        Naming a non-finite node, or the two cells and the facet's vertices.
     """
-    message = _bad_cells_message(mesh) if mesh.geometry.dim == mesh.topology.dim else None
-    # every rank raises, so that none waits in a collective for the other
-    messages = [m for m in mesh.comm.allgather(message) if m]
-    if messages:
-        raise ValueError(messages[0])
+    with collective_checks(mesh.comm):
+        _check_finite_coordinates(mesh)
+        message = _bad_cells_message(mesh) if mesh.geometry.dim == mesh.topology.dim else None
+        if message:
+            raise ValueError(message)
+
+
+def _check_finite_coordinates(mesh: dolfinx.mesh.Mesh) -> None:
+    """Refuse NaN or infinite node coordinates, naming a node (they were reported
+    as "a cell of zero size" at the finite vertices of a facet next to it)."""
+    gdim = mesh.geometry.dim
+    x = mesh.geometry.x[:, :gdim]
+    bad = np.flatnonzero(~np.isfinite(x).all(axis=1))
+    if len(bad):
+        node_map = mesh.geometry.index_map()
+        global_node = int(node_map.local_to_global(bad[:1].astype(np.int32))[0])
+        raise ValueError(f"the mesh has NaN or infinite node coordinates: node {global_node} "
+                         f"(global geometry node number) is at {x[bad[0]].tolist()}; "
+                         f"{len(bad)} such node(s) on rank {mesh.comm.rank}")
 
 
 def _bad_cells_message(mesh: dolfinx.mesh.Mesh) -> Optional[str]:
@@ -159,22 +292,24 @@ def check_tags(mesh, facet_tags, tags: Iterable) -> None:
     ValueError
         For a tag that marks no facet, with the tags present.
     """
-    if not np.issubdtype(np.asarray(facet_tags.values).dtype, np.integer):
-        raise TypeError(f"facet tag values must be integers, got "
-                        f"{np.asarray(facet_tags.values).dtype}")
-    if facet_tags.dim != mesh.topology.dim - 1:
-        raise ValueError(f"the meshtags have dimension {facet_tags.dim}; contact needs facet "
-                         f"tags (dimension {mesh.topology.dim - 1})")
+    with collective_checks(mesh.comm):
+        if not np.issubdtype(np.asarray(facet_tags.values).dtype, np.integer):
+            raise TypeError(f"facet tag values must be integers, got "
+                            f"{np.asarray(facet_tags.values).dtype}")
+        if facet_tags.dim != mesh.topology.dim - 1:
+            raise ValueError(f"the meshtags have dimension {facet_tags.dim}; contact needs "
+                             f"facet tags (dimension {mesh.topology.dim - 1})")
+        tags = [tag for tag in tags if tag is not None]
+        for tag in tags:
+            if not isinstance(tag, (int, np.integer)):
+                raise TypeError(f"tags must be integers, got {tag!r} ({type(tag).__name__})")
     present = {int(t) for values in mesh.comm.allgather(np.unique(facet_tags.values))
                for t in values}
-    for tag in tags:
-        if tag is None:
-            continue
-        if not isinstance(tag, (int, np.integer)):
-            raise TypeError(f"tags must be integers, got {tag!r} ({type(tag).__name__})")
-        if tag not in present:
-            raise ValueError(f"facet tag {tag} marks no facets (tags present: "
-                             f"{sorted(present)})")
+    with collective_checks(mesh.comm):
+        for tag in tags:
+            if tag not in present:
+                raise ValueError(f"facet tag {tag} marks no facets (tags present: "
+                                 f"{sorted(present)})")
 
 
 def check_contact_tags(mesh, facet_tags, slave_tag: int, master_tag: Optional[int]) -> None:
@@ -196,13 +331,22 @@ def check_contact_arguments(u, master_tag: Optional[int], obstacle,
                         f"{type(u).__name__}")
     V = u.function_space
     gdim = V.mesh.geometry.dim
+    if gdim < 2 or V.mesh.topology.dim < 2:
+        # it failed with a numpy IndexError in the check of the cells
+        raise ValueError(f"contact needs a 2D or 3D mesh, got a mesh of topological "
+                         f"dimension {V.mesh.topology.dim} in {gdim}D")
     if V.dofmap.index_map_bs != gdim:
         raise ValueError(f"u must be a vector Function with {gdim} components per node")
     if (master_tag is None) == (obstacle is None):
         raise ValueError("give exactly one of master_tag (elastic master) and obstacle "
                          "(rigid analytic obstacle)")
+    if obstacle is not None and not all(hasattr(obstacle, name) for name in
+                                        ("gdim", "signed_distance", "gradient", "hessian")):
+        raise TypeError(f"the obstacle must be a rigid obstacle (RigidPlane, RigidSphere, "
+                        f"RigidCylinder, …), got {type(obstacle).__name__}")
     if obstacle is not None and obstacle.gdim != gdim:
         raise ValueError(f"a {obstacle.gdim}D obstacle in a {gdim}D mesh: the option "
                          "does not fit the mesh's dimension")
     if axisymmetric and gdim != 2:
         raise ValueError(f"axisymmetric contact needs a 2D (r, z) mesh, got a {gdim}D one")
+

@@ -43,6 +43,17 @@ class Translatable:
     """A rigid obstacle placed by a reference point (``anchor``) that moves."""
 
     anchor_name = "point"
+    #: the attributes that :meth:`__repr__` shows, in the constructor's order
+    shown: tuple[str, ...] = ()
+
+    def __repr__(self) -> str:
+        """The obstacle as it is now, e.g. ``RigidPlane(point=[0, 0], normal=[0, 1])``
+        (for messages that name it)."""
+        def value(name):
+            v = getattr(self, name)
+            return [float(f"{c:.6g}") for c in v] if np.ndim(v) else float(f"{v:.6g}")
+        return (f"{type(self).__name__}("
+                + ", ".join(f"{name}={value(name)}" for name in self.shown) + ")")
 
     def _init_anchor(self) -> None:
         self._initial = getattr(self, self.anchor_name).copy()
@@ -62,6 +73,8 @@ class RigidPlane(Translatable):
 
     The normal points out of the obstacle, into the space where the body is.
     """
+
+    shown = ("point", "normal")
 
     def __init__(self, point: Sequence[float], normal: Sequence[float]):
         self.point = _vector(point, "point")
@@ -89,6 +102,7 @@ class RigidSphere(Translatable):
     """A solid ball (a disk in 2D: the section of a rigid cylinder)."""
 
     anchor_name = "center"
+    shown = ("center", "radius")
 
     def __init__(self, center: Sequence[float], radius: float):
         self.center = _vector(center, "center")
@@ -115,6 +129,8 @@ class RigidSphere(Translatable):
 
 class RigidCylinder(Translatable):
     """A solid circular cylinder in 3D with an axis through ``point`` along ``axis``."""
+
+    shown = ("point", "axis", "radius")
 
     def __init__(self, point: Sequence[float], axis: Sequence[float], radius: float):
         self.point = _vector(point, "point")

@@ -40,8 +40,12 @@ from dolfinx_mortar.contact.results import ContactResults
 from dolfinx_mortar.contact.state import ContactState, GapModel
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.kinds import KindLike
+from dolfinx_mortar.contact.setup_checks import (check_initial_overlap,
+                                                 check_penalty_represents_a_force,
+                                                 warn_if_the_obstacle_faces_away)
 from dolfinx_mortar.input_checks import (check_cells, check_contact_arguments,
-                                         check_contact_tags)
+                                         check_contact_tags, collective_checks,
+                                         communicator_of)
 from dolfinx_mortar.surfaces.facet_surface import facet_surface
 
 FloatArray = npt.NDArray[np.float64]
@@ -114,13 +118,16 @@ class ContactTerm:
                  boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, axisymmetric: bool = False,
                  friction: Optional[CoulombFriction] = None):
-        check_contact_arguments(u, master_tag, obstacle, axisymmetric)
-        if friction is not None and not isinstance(friction, CoulombFriction):
-            raise TypeError(f"friction must be a CoulombFriction or None, got "
-                            f"{type(friction).__name__}")
-        options = ContactOptions.checked(kind, penalty, scaling, active_set,
-                                         basis_configuration, boundary_modification,
-                                         search_radius, master_tag is not None, axisymmetric)
+        # one decision of all ranks: an argument bad on one rank only raises on every rank
+        with collective_checks(communicator_of(u)):
+            check_contact_arguments(u, master_tag, obstacle, axisymmetric)
+            if friction is not None and not isinstance(friction, CoulombFriction):
+                raise TypeError(f"friction must be a CoulombFriction or None, got "
+                                f"{type(friction).__name__}")
+            options = ContactOptions.checked(kind, penalty, scaling, active_set,
+                                             basis_configuration, boundary_modification,
+                                             search_radius, master_tag is not None,
+                                             axisymmetric)
         V = u.function_space
         mesh = V.mesh
         check_cells(mesh)
@@ -130,6 +137,7 @@ class ContactTerm:
         self.slave = facet_surface(V, facet_tags, slave_tag, quadratic_transform, axisymmetric)
         self.master = (facet_surface(V, facet_tags, master_tag, axisymmetric=axisymmetric)
                        if master_tag is not None else None)
+        check_penalty_represents_a_force(options.penalty, self.slave, mesh.comm)
         #: the checked options (kind, penalty law, configuration, …)
         self.options = options
         #: where the bases live and when they move
@@ -158,7 +166,11 @@ class ContactTerm:
             self.friction = Friction(friction, options, u, self.slave, obstacle, step_start)
         self.model: GapModel = self._timed_build(self.configuration.build, options)
         self.checks.warn_deep_initial_penetration()
-        self.checks.warn_if_no_master_is_in_reach(self.configuration.segmentation(self.model))
+        if obstacle is not None:
+            warn_if_the_obstacle_faces_away(obstacle, self.slave, mesh.comm)
+        coupling = self.configuration.segmentation(self.model)
+        check_initial_overlap(self, coupling)
+        self.checks.warn_if_no_master_is_in_reach(coupling)
 
     # -- configuration ---------------------------------------------------------------
     @property

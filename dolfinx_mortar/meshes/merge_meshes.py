@@ -156,7 +156,10 @@ def merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b, comm: Optional[MPI.
     clash = sorted((_global_values(comm, facet_tags_a.values)
                     & _global_values(comm, values_b)) - shared)
     if clash:
-        raise ValueError(f"facet tag values {clash} mark facets of both meshes; pass "
+        # name b's values as the user wrote them, not only as shifted
+        written = (f" (mesh_b's {[v - int(tag_offset) for v in clash]} shifted by tag_offset "
+                   f"{tag_offset})" if tag_offset else "")
+        raise ValueError(f"facet tag values {clash} mark facets of both meshes{written}; pass "
                          "tag_offset= to shift mesh_b's values, or list the values in "
                          "shared_tags= if they are meant to mark both bodies")
 

@@ -22,7 +22,9 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.friction_law import CoulombFriction
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.term import ContactTerm
-from dolfinx_mortar.input_checks import check_boundary_data, check_tags
+from dolfinx_mortar.contact.setup_checks import check_penalty_against_stiffness
+from dolfinx_mortar.input_checks import (check_boundary_data, check_tags, collective_checks,
+                                         communicator_of)
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.small_strain.axisymmetric import axisymmetric_elastic_residual, circumference
 from dolfinx_mortar.solver.load_path import LoadPathSolver, SolveResult, StepResult
@@ -84,17 +86,19 @@ class ContactProblem:
                  search_radius: Optional[float] = None, petsc_options: Optional[dict] = None,
                  axisymmetric: bool = False, linear_solver: str = "auto",
                  friction: Optional[CoulombFriction] = None):
-        mesh = V.mesh
-        gdim = mesh.geometry.dim
-        if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
-            raise ValueError(f"need a finite E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
-        if nu > NEARLY_INCOMPRESSIBLE and V.ufl_element().degree == 1:
-            warnings.warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
-                          "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the contact "
-                          "force of nu = 0.3); use quadratic elements or a mixed form",
-                          RuntimeWarning, stacklevel=2)
-        fixed, tractions = fixed or {}, tractions or {}
-        check_boundary_data(fixed, tractions, gdim)
+        # one decision of all ranks: an argument bad on one rank only raises on every rank
+        with collective_checks(communicator_of(V)):
+            mesh = V.mesh
+            gdim = mesh.geometry.dim
+            if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
+                raise ValueError(f"need a finite E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
+            if nu > NEARLY_INCOMPRESSIBLE and V.ufl_element().degree == 1:
+                warnings.warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
+                              "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the "
+                              "contact force of nu = 0.3); use quadratic elements or a "
+                              "mixed form", RuntimeWarning, stacklevel=2)
+            fixed, tractions = fixed or {}, tractions or {}
+            check_boundary_data(fixed, tractions, gdim)
         check_tags(mesh, facet_tags, [*fixed, *tractions])
         self.V, self.mesh, self.facet_tags = V, mesh, facet_tags
         self.u = fem.Function(V, name="displacement")
@@ -104,6 +108,8 @@ class ContactProblem:
             basis_configuration=basis_configuration, quadratic_transform=quadratic_transform,
             boundary_modification=boundary_modification, search_radius=search_radius,
             axisymmetric=axisymmetric, friction=friction)
+        check_penalty_against_stiffness(self.contact.options.penalty, E, self.contact.slave,
+                                        mesh.comm)
         #: the load factor, 0 … 1
         self.load = fem.Constant(mesh, PETSc.ScalarType(0.0))
         v = ufl.TestFunction(V)
@@ -223,6 +229,15 @@ class ContactProblem:
         kept as ``problem.facet_tags`` and ``problem.cell_tags``.
         """
         from dolfinx_mortar.meshes.merge_meshes import merge_meshes
+        # the tags as the user wrote them, before b's are shifted by tag_offset: a
+        # wrong master_tag 7 was named as the merged tag 17
+        for name, tag, domain, tags in (("slave_tag", slave_tag, mesh_a, facet_tags_a),
+                                        ("master_tag", master_tag, mesh_b, facet_tags_b)):
+            try:
+                check_tags(domain, tags, [tag])
+            except (TypeError, ValueError) as error:
+                body = "mesh_a" if domain is mesh_a else "mesh_b"
+                raise type(error)(f"{name} {tag!r} of {body}: {error}") from None
         mesh, facet_tags, cell_tags = merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b,
                                                    tag_offset=tag_offset,
                                                    shared_tags=shared_tags)

@@ -32,6 +32,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
+from dolfinx_mortar.input_checks import checked_contact_terms, load_data, non_finite_input
 from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 
@@ -77,22 +78,15 @@ class NonlinearContactProblem:
         self.petsc_options = dict(petsc_options or {})
         self._snes: Optional[PETSc.SNES] = None
         self.bcs = list(bcs)
-        self.contacts = [contact] if isinstance(contact, ContactTerm) else list(contact)
-        if not self.contacts:
-            raise ValueError("no contact term: use dolfinx.fem.petsc.NonlinearProblem")
-        for term in self.contacts:
-            if term.u is not u:
-                raise ValueError("every contact term must be built on the problem's u")
-        if len(self.contacts) > 1 and any(term.entry.takes_the_linear_solve
-                                          for term in self.contacts):
-            raise NotImplementedError("a GLS kind (augmented Newton step) must be the only "
-                                      "contact term of a problem")
+        self.contacts = checked_contact_terms(u, contact)
         fc = form_compiler_options or {}
         jit = jit_options or {}
         self.L = fem.form(F, form_compiler_options=fc, jit_options=jit)
         if J is None:
             J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
         self.a = fem.form(J, form_compiler_options=fc, jit_options=jit)
+        #: what the load path may set (checked to be finite at each :meth:`F`)
+        self._load_data = load_data([F, J], u, self.bcs)
         #: whether the bulk residual is linear in u (its Jacobian does not depend
         #: on u): the load path's line search shortens frozen-phase steps only
         #: for a nonlinear bulk (:meth:`LoadPathSolver.library_line_search`)
@@ -158,6 +152,14 @@ class NonlinearContactProblem:
         if self._take_offer(x, b):
             # the contact states are those of the offer's evaluation, at this x
             return
+        # a NaN load (set by the load path) made SNES raise "error code -1" from
+        # inside the contact's evaluation at the NaN iterate that followed
+        iterate_finite, self.evaluation_error = non_finite_input(
+            self.u.function_space.mesh.comm, x, self._load_data)
+        if not iterate_finite:
+            with b.localForm() as local:
+                local.set(np.nan)
+            return
         with b.localForm() as local:
             local.set(0.0)
         fem_petsc.assemble_vector(b, self.L)
@@ -177,6 +179,9 @@ class NonlinearContactProblem:
                 local.set(np.nan)
             return
         fem_petsc.set_bc(b, self.bcs, self.u.x.petsc_vec, -1.0)
+        if self.evaluation_error is not None:     # a non-finite load: see above
+            with b.localForm() as local:
+                local.set(np.nan)
 
     def J(self, x: PETSc.Vec, A: PETSc.Mat, ksp: Optional[PETSc.KSP] = None) -> None:
         """Assemble the Jacobian at the state of the last :meth:`F` into ``A``.

@@ -61,13 +61,18 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     element = space.ufl_element()
     degree = element.degree
     family = element.family_name
+    if getattr(element, "discontinuous", False):
+        # its dofs belong to the cells, none to the facets: it failed with "P1 line
+        # cells need 2 nodes each, got cells of shape (8, 0)"
+        raise ValueError(f"contact needs a continuous Lagrange (CG, P1/P2) space, got a "
+                         f"discontinuous (DG) {family} space of degree {degree}")
     if family not in ("Lagrange", "Q", "P") or degree not in (1, 2):
         raise ValueError(f"slave surfaces need a Lagrange space of degree 1 or 2, "
                          f"got {family} of degree {degree}")
     tdim = mesh.topology.dim
     fdim = tdim - 1
     if tdim < 2:
-        raise ValueError("slave surfaces need a 2D or 3D mesh")
+        raise ValueError(f"contact surfaces need a 2D or 3D mesh, got a {tdim}D one")
     if facet_tags.dim != fdim:
         raise ValueError(f"the meshtags have dimension {facet_tags.dim}, but the slave "
                          f"surface needs facet tags (dimension {fdim}) of this "
