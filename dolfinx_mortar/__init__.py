@@ -60,6 +60,7 @@ _LAZY = {
     "RigidSphere": "dolfinx_mortar.contact.obstacles",
     "RigidCylinder": "dolfinx_mortar.contact.obstacles",
     "SurfacePressure": "dolfinx_mortar.contact.results",
+    "SurfaceFriction": "dolfinx_mortar.contact.results",
     "CoulombFriction": "dolfinx_mortar.contact.friction_law",
 }
 

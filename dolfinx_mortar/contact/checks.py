@@ -19,6 +19,7 @@ from mpi4py import MPI
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import DUAL_KINDS
 from dolfinx_mortar.mortar.coupling import MortarCoupling
+from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -27,6 +28,9 @@ DEEP_PENETRATION = 0.5
 #: a penetration at convergence deeper than this many slave element lengths is
 #: warned about: the penalty is low for the mesh (ε 1000× too low gave 0.055)
 PENALTY_PENETRATION = 0.01
+#: a node off the slave surface that has passed through a rigid obstacle by more
+#: than this many lengths of its cells at convergence is warned about (logged)
+BODY_PENETRATION = 0.25
 #: the penetration, in element lengths, that the suggested penalty aims at
 SUGGESTED_PENETRATION = 1e-3
 #: basis_configuration="initial" is warned about past this many element lengths of slip
@@ -37,12 +41,59 @@ MAX_RADIUS_WIDENINGS = 3
 logger = logging.getLogger(__name__)
 
 
+def body_penetration(term) -> tuple[float, float, list]:
+    """The deepest penetration into the rigid obstacle of a node of u off the
+    slave surface, at the present u of the contact term ``term``, over every
+    rank: (in lengths of the node's largest cell, as a length, the node's
+    reference coordinates).
+
+    The contact holds only the slave surface's nodes
+    (:meth:`~dolfinx_mortar.contact.results.ContactResults.penetration`);
+    the rest of the mesh may pass through the obstacle where the slave
+    surface does not reach, or when the body folds through itself under a
+    load far beyond a small-strain model's range (a cylinder on a plane at
+    1000× the Hertz load: the slave nodes 0.005 elements deep, the
+    cylinder's top 3.4 radii through the plane). Only nodes that started
+    outside the obstacle count; without one (an elastic master), nothing
+    is measured: (-inf, 0, []).
+    """
+    obstacle = term.obstacle
+    comm = term.mesh.comm
+    if obstacle is None:
+        return (-np.inf, 0.0, [])
+    V = term.V
+    gdim = term.slave.gdim
+    owned = V.dofmap.index_map.size_local
+    X_all = V.tabulate_dof_coordinates()[:, :gdim]
+    X = X_all[:owned]
+    u = term.u.x.array.reshape(-1, gdim)[:owned]
+    # where the obstacle started (a moved obstacle is a translated one)
+    start = np.asarray(getattr(obstacle, "displacement", np.zeros(gdim)))
+    outside = obstacle.signed_distance(X + start) >= -zero_length(length_scale(X, comm))
+    held = np.unique(term.slave.cells)        # slave cells number u's nodes
+    outside[held[held < owned]] = False
+    depth = np.where(outside, -obstacle.signed_distance(X + u), -np.inf)
+    # each node's length: the largest diameter of its cells (of their nodes' spread)
+    dofs = V.dofmap.list
+    corners = X_all[dofs]
+    size = np.linalg.norm(corners[:, :, None] - corners[:, None], axis=-1).max(axis=(1, 2),
+                                                                              initial=0.0)
+    length = np.zeros(len(X_all))
+    np.maximum.at(length, dofs, np.repeat(size[:, None], dofs.shape[1], axis=1))
+    ratio = depth / np.maximum(length[:owned], np.finfo(float).tiny)
+    worst = int(np.argmax(ratio)) if owned else -1
+    local = ((float(ratio[worst]), float(depth[worst]), X[worst].tolist())
+             if owned and np.isfinite(ratio[worst]) else (-np.inf, 0.0, []))
+    return max(comm.allgather(local), key=lambda item: item[0])
+
+
 class RangeChecks:
     """The checks of one contact term (``term.checks``); each warns once."""
 
     def __init__(self, term):
         self.term = term
         self._slip_warned = False
+        self._body_warned = False
         #: (coupling, slave nodes a four times wider search pairs) of the last check
         self._beyond_radius: Optional[tuple] = None
         #: times the default search radius was widened, and whether reaching it was warned
@@ -84,7 +135,12 @@ class RangeChecks:
         The penetration falls about as 1/ε, exactly so under a prescribed
         force. A penalty 1000 times too low penetrated by 5.5% of an element
         without a word.
+
+        A load-path driver calls it at the end of a solve; it checks the
+        nodes off the slave surface too (:meth:`warn_if_the_body_passed_through`),
+        which this check, on the slave nodes' ``p_A/ε``, does not see.
         """
+        self.warn_if_the_body_passed_through()
         ratio, depth, x = deepest
         if ratio <= PENALTY_PENETRATION:
             return
@@ -95,6 +151,37 @@ class RangeChecks:
                       f"{penalty:.3g} is low for this mesh; about {suggested:.3g} would "
                       f"bring the penetration to {SUGGESTED_PENETRATION:g} element lengths "
                       "(it falls about as 1/penalty)", RuntimeWarning, stacklevel=3)
+
+    def warn_if_the_body_passed_through(self) -> None:
+        """Log a warning (once, collective) when at the present u a node off the
+        slave surface has passed through the rigid obstacle by more than
+        BODY_PENETRATION lengths of its cells
+        (:func:`body_penetration`).
+
+        A cylinder on a rigid plane under 1000× its Hertz load, in small-strain
+        elasticity, converged with the top of the cylinder 3.4 radii through
+        the plane and no word: the penalty check saw only the slave nodes,
+        held 0.005 elements deep.
+        """
+        if self._body_warned:
+            return
+        ratio, depth, x = body_penetration(self.term)
+        if ratio <= BODY_PENETRATION:
+            return
+        self._body_warned = True
+        held, _, _ = self.term.results.penetration()
+        if self.term.mesh.comm.rank == 0:
+            where = ", ".join(f"{c:.4g}" for c in x)
+            logger.warning(
+                "at convergence a node off the slave surface has passed through the obstacle "
+                "by %.3g (%.3g lengths of its cells; reference point (%s)), while the slave "
+                "surface's nodes penetrate by at most %.2g element lengths: the body has "
+                "folded past its own slave surface (cells turned inside out under a load far "
+                "beyond a small-strain model's range), or the slave surface does not cover "
+                "all of the body that meets the obstacle. Check the load and the slave tag; "
+                "with a large-deformation material take more load steps; where the slave "
+                "surface itself sinks in, a larger penalty (now %.3g)",
+                depth, ratio, where, max(held, 0.0), self.term.options.penalty)
 
     def warn_if_slipped_too_far(self, state: Optional[ContactState] = None) -> None:
         """With ``basis_configuration="initial"``: warn (once) past SLIP_LIMIT

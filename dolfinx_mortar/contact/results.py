@@ -8,6 +8,8 @@ Each figure, with what it is:
   contact pressure in the partition-of-unity basis (``ε⟨d̄_A⟩``);
 - :meth:`ContactResults.surface_pressure`: the same ``p_A`` at the slave surface's
   nodes only, with their coordinates (per rank or gathered);
+- :meth:`ContactResults.surface_friction`: with friction, the tangential
+  traction ``q_A`` and the stick/slip state there, in the same form;
 - :meth:`ContactResults.mortar_traction`: ``p* = Σ f_A M_A`` per slave cell,
   the traction whose virtual work the residual is;
 - :meth:`ContactResults.normal_force`: ``Σ_A W_A p_A``, the integral of the
@@ -57,6 +59,31 @@ class SurfacePressure:
     global_index: npt.NDArray[np.int64]
 
 
+@dataclass(frozen=True)
+class SurfaceFriction:
+    """The tangential traction and the stick/slip state at the nodes of a slave
+    surface, in the form of :class:`SurfacePressure`.
+
+    Attributes
+    ----------
+    x
+        Reference (undeformed) coordinates of the nodes, shape (n, gdim).
+    q
+        The tangential traction ``q_A`` on the slave body at them, shape (n, gdim)
+        (:meth:`ContactResults.tangential_tractions`); 0 where separated.
+    stick_slip
+        Their state, shape (n,): 0 separated, 1 stick, 2 slip
+        (:meth:`ContactResults.slip_states`).
+    global_index
+        The nodes' global indices in the displacement space's node numbering.
+    """
+
+    x: FloatArray
+    q: FloatArray
+    stick_slip: npt.NDArray[np.int8]
+    global_index: npt.NDArray[np.int64]
+
+
 class ContactResults:
     """What a :class:`~dolfinx_mortar.contact.term.ContactTerm` reports at the
     present u (or at a state it evaluated): ``term.results``."""
@@ -86,22 +113,29 @@ class ContactResults:
             False: the surface nodes this rank owns, in local order. True: every surface node
             of all ranks, on every rank, sorted by coordinates (x first, then y, then z).
         """
+        x, p, index = self._at_surface_nodes(gather, self.nodal_pressures(state))
+        return SurfacePressure(x, p, index)
+
+    def _at_surface_nodes(self, gather: bool, *values: np.ndarray) -> tuple:
+        """The slave surface's nodes' coordinates, ``values`` (arrays over the
+        local slave-layout nodes) there and the nodes' global indices: this
+        rank's owned surface nodes in local order, or (``gather``) every rank's
+        on every rank, sorted by coordinates. Collective if ``gather``."""
         slave = self.term.slave
         layout = slave.layout
         n = layout.num_owned
         nodes = np.flatnonzero(layout.on_cells(slave.cells)[:n])
-        part = SurfacePressure(slave.x[nodes], self.nodal_pressures(state)[nodes],
-                               layout.global_indices[nodes])
+        part = (slave.x[nodes], [v[nodes] for v in values], layout.global_indices[nodes])
         if not gather:
-            return part
+            return (part[0], *part[1], part[2])
         parts = self.term.mesh.comm.allgather(part)
-        x = np.concatenate([q.x for q in parts]).reshape(-1, slave.gdim)
+        x = np.concatenate([q[0] for q in parts]).reshape(-1, slave.gdim)
         # coordinates equal up to round-off (a mesh generator's 0 may be -2e-18) are equal
         # here, so that the order does not depend on where round-off lands
         zero = zero_length(length_scale(x))
         order = np.lexsort(np.round(x / zero).T[::-1])
-        return SurfacePressure(x[order], np.concatenate([q.p for q in parts])[order],
-                               np.concatenate([q.global_index for q in parts])[order])
+        gathered = [np.concatenate([q[1][k] for q in parts])[order] for k in range(len(values))]
+        return (x[order], *gathered, np.concatenate([q[2] for q in parts])[order])
 
     def mortar_traction(self, state: Optional[ContactState] = None) -> FloatArray:
         """The contact traction ``p*`` at the nodes of every slave cell, (cells, nodes):
@@ -146,7 +180,8 @@ class ContactResults:
         """``q_A = −f_T,A / W_A^k``: the coefficients of the tangential traction
         on the slave body in the partition-of-unity basis, as ``p_A`` is of the
         pressure, at the local slave-layout nodes, (nodes, gdim); it opposes
-        the slave's slip relative to what it touches, and ``|q_A| ≤ μ p_A``."""
+        the slave's slip relative to what it touches, and ``|q_A| ≤ μ p_A``.
+        With the nodes' coordinates: :meth:`surface_friction`."""
         state = state or self.term.evaluate()
         W = state.lumped_weights
         force = -self._friction(state).mapping.force
@@ -158,8 +193,34 @@ class ContactResults:
 
     def slip_states(self, state: Optional[ContactState] = None) -> npt.NDArray[np.int8]:
         """Per local slave-layout node: 0 separated, 1 stick, 2 slip
-        (:data:`~dolfinx_mortar.contact.friction_law.STICK`, …)."""
+        (:data:`~dolfinx_mortar.contact.friction_law.STICK`, …). With the
+        nodes' coordinates: :meth:`surface_friction`."""
         return self._friction(state).mapping.state.copy()
+
+    def surface_friction(self, state: Optional[ContactState] = None,
+                         gather: bool = False) -> SurfaceFriction:
+        """The tangential traction and the stick/slip state at the slave
+        surface's nodes, with their coordinates (as :meth:`surface_pressure`).
+
+        Collective.
+
+        Parameters
+        ----------
+        state
+            A contact state; by default the one at the present u.
+        gather
+            False: the surface nodes this rank owns, in local order. True: every surface node
+            of all ranks, on every rank, sorted by coordinates (x first, then y, then z).
+
+        Raises
+        ------
+        ValueError
+            If the term has no friction.
+        """
+        state = state or self.term.evaluate()
+        x, q, stick_slip, index = self._at_surface_nodes(
+            gather, self.tangential_tractions(state), self.slip_states(state))
+        return SurfaceFriction(x, q, stick_slip, index)
 
     def tangential_force(self, state: Optional[ContactState] = None) -> FloatArray:
         """The resultant of the tangential (friction) traction on the slave

@@ -39,6 +39,7 @@ from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.results import ContactResults
 from dolfinx_mortar.contact.state import ContactState, GapModel
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
+from dolfinx_mortar.io.contact_output import check_term_name
 from dolfinx_mortar.kinds import KindLike
 from dolfinx_mortar.contact.setup_checks import (check_initial_overlap,
                                                  check_penalty_represents_a_force,
@@ -108,6 +109,11 @@ class ContactTerm:
         Coulomb friction (:class:`~dolfinx_mortar.contact.friction_law.CoulombFriction`:
         μ and the tangential penalty), or None (frictionless, default). Its
         history moves on in :meth:`accept_step` (docs/FRICTION.md).
+    name
+        The term's name, which names its output file ``<output>_<name>.xdmf``
+        (letters, digits, ``_``, ``-``). None (default): ``<output>_slave.xdmf``
+        when it is a problem's only term, ``<output>_slave<slave_tag>.xdmf``
+        among several (:mod:`dolfinx_mortar.io.contact_output`).
     """
 
     def __init__(self, u: fem.Function, facet_tags, slave_tag: int, *,
@@ -117,10 +123,12 @@ class ContactTerm:
                  quadratic_transform: bool = False,
                  boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, axisymmetric: bool = False,
-                 friction: Optional[CoulombFriction] = None):
+                 friction: Optional[CoulombFriction] = None, name: Optional[str] = None):
         # one decision of all ranks: an argument bad on one rank only raises on every rank
         with collective_checks(communicator_of(u)):
             check_contact_arguments(u, master_tag, obstacle, axisymmetric)
+            #: the name of the term's output (None: from the slave tag)
+            self.name: Optional[str] = check_term_name(name)
             if friction is not None and not isinstance(friction, CoulombFriction):
                 raise TypeError(f"friction must be a CoulombFriction or None, got "
                                 f"{type(friction).__name__}")
@@ -132,6 +140,7 @@ class ContactTerm:
         mesh = V.mesh
         check_cells(mesh)
         check_contact_tags(mesh, facet_tags, slave_tag, master_tag)
+        self.slave_tag = int(slave_tag)
         self.u, self.V, self.mesh = u, V, mesh
         self.obstacle = obstacle
         self.slave = facet_surface(V, facet_tags, slave_tag, quadratic_transform, axisymmetric)

@@ -5,15 +5,20 @@ With friction the slave facets carry the tangential traction ``q_hat_x``,
 1 stick, 2 slip) too.
 
 Every converged step goes to ``<output>.xdmf`` (displacement and nodal
-pressure on the mesh) and to ``<output>_slave.xdmf`` (``p_hat`` and ``p_star``
-per slave facet, since ``p*`` may jump); with several contact terms the
-second and later ones write ``<output>_slave1.xdmf``, … Both files are
-complete on disk after every step (:mod:`dolfinx_mortar.io.xdmf_series`).
+pressure on the mesh, the sum over the contact terms) and to one file per
+contact term with ``p_hat`` and ``p_star`` per slave facet (``p*`` may jump):
+``<output>_<name>.xdmf`` for a term made with ``name=...``; for a term
+without a name ``<output>_slave.xdmf`` when it is the only term,
+``<output>_slave<slave_tag>.xdmf`` among several (``run_slave3.xdmf`` for
+slave tag 3). Two terms that would write the same file are refused. The
+files are complete on disk after every step
+(:mod:`dolfinx_mortar.io.xdmf_series`).
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
-from typing import Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 import dolfinx
@@ -22,6 +27,43 @@ from dolfinx import fem
 from dolfinx_mortar import dolfinx_compat
 from dolfinx_mortar.io.surface_output import SlaveSurfaceOutput, surface_output_path
 from dolfinx_mortar.io.xdmf_series import XdmfSeries
+
+
+def check_term_name(name: Optional[str]) -> Optional[str]:
+    """A contact term's name as given, if it can name a file; None stays None.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a name that is no string, or not made of letters, digits, ``_``, ``-``.
+    """
+    if name is None:
+        return None
+    if not isinstance(name, str):
+        raise TypeError(f"a contact term's name must be a string, not {type(name).__name__}")
+    if not re.fullmatch(r"[A-Za-z0-9_-]+", name):
+        raise ValueError(f"a contact term's name names its output file (<output>_<name>.xdmf): "
+                         f"letters, digits, '_' and '-' only, not {name!r}")
+    return name
+
+
+def output_names(contacts: Sequence) -> list[str]:
+    """What each contact term's output file is named after (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        If two terms would write the same file.
+    """
+    names = [term.name if term.name is not None
+             else "slave" if len(contacts) == 1 else f"slave{term.slave_tag}"
+             for term in contacts]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ValueError(f"several contact terms would write <output>_{twice[0]}.xdmf: give "
+                         "each ContactTerm its own name= (names of the terms: "
+                         f"{', '.join(names)})")
+    return names
 
 
 class ContactOutput:
@@ -40,14 +82,11 @@ class ContactOutput:
     def __init__(self, path: Path, u: fem.Function, contacts: Sequence):
         path = Path(path)
         self.u, self.contacts = u, list(contacts)
+        names = output_names(self.contacts)         # refused before any file is made
         mesh = u.function_space.mesh
         self.mesh_output = XdmfSeries(path, mesh)
-        self.surface_outputs = []
-        for i, term in enumerate(self.contacts):
-            p = surface_output_path(path)
-            if i:
-                p = p.with_name(p.stem + str(i) + p.suffix)
-            self.surface_outputs.append(SlaveSurfaceOutput(term.slave, p))
+        self.surface_outputs = [SlaveSurfaceOutput(term.slave, surface_output_path(path, name))
+                                for term, name in zip(self.contacts, names)]
         V = u.function_space
         degree = dolfinx_compat.coordinate_element(mesh).degree
         self.V1 = fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))

@@ -3,7 +3,10 @@ physical groups, optionally with the contact surfaces spread over the ranks.
 
 The model is opened on one rank and handed to DOLFINx's ``model_to_mesh``
 (through :mod:`dolfinx_mortar.dolfinx_compat`, which hides where that lives
-and what it returns in each DOLFINx release).
+and what it returns in each DOLFINx release). Unlike DOLFINx's, whose
+``gdim`` is 3 unless given, the geometric dimension is by default the
+model's own (:func:`model_dimension`): a 2D .msh read with gdim 3 made a
+mesh that failed deep inside the contact term.
 """
 from __future__ import annotations
 
@@ -14,9 +17,36 @@ import numpy as np
 from mpi4py import MPI
 
 from dolfinx_mortar import dolfinx_compat
+from dolfinx_mortar.tolerance import length_scale, zero_length
 
 
-def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: int = 3,
+def model_dimension(model, comm: MPI.Comm, rank: int = 0) -> int:
+    """The geometric dimension of a gmsh model's mesh (collective).
+
+    The topological dimension ``tdim`` is that of the highest physical group
+    (the cells DOLFINx makes); the geometric dimension is ``tdim`` when every
+    node's coordinates beyond the first ``tdim`` are zero on the scale of the
+    mesh (a 2D mesh in the plane z = 0), else 3 (a surface in space).
+
+    Parameters
+    ----------
+    model
+        The gmsh model with its mesh, built on ``rank``.
+    comm, rank
+        The communicator and the rank that holds the model.
+    """
+    gdim = None
+    if comm.rank == rank:
+        groups = model.getPhysicalGroups()
+        tdim = max((dim for dim, _ in groups), default=model.getDimension())
+        x = model.mesh.getNodes()[1].reshape(-1, 3)
+        beyond = np.abs(x[:, tdim:])
+        flat = not beyond.size or beyond.max() <= zero_length(length_scale(x))
+        gdim = int(tdim) if flat and tdim > 0 else 3
+    return comm.bcast(gdim, root=rank)
+
+
+def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: Optional[int] = None,
                   balance_facets: Optional[Sequence[int]] = None):
     """DOLFINx's ``model_to_mesh`` as ``(mesh, cell_tags, facet_tags)`` in
     every supported release, optionally with the cells next to some facets
@@ -26,8 +56,11 @@ def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: int = 3,
     ----------
     model
         The gmsh model, built on ``rank``.
-    comm, rank, gdim
+    comm, rank
         As for DOLFINx's ``model_to_mesh``.
+    gdim
+        The geometric dimension; None (default): the model's own
+        (:func:`model_dimension`: 2 for a mesh in the plane z = 0).
     balance_facets
         Physical tags of the facet groups (the contact surfaces) whose
         adjacent cells every rank should get an equal share of
@@ -43,6 +76,8 @@ def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: int = 3,
     ValueError
         If a tag in ``balance_facets`` is no physical group of facets.
     """
+    if gdim is None:
+        gdim = model_dimension(model, comm, rank)
     if balance_facets is None:
         return dolfinx_compat.model_to_mesh(model, comm, rank, gdim=gdim)
     tags = [int(t) for t in balance_facets]
@@ -99,11 +134,12 @@ def _contact_cell_partitioner(comm: MPI.Comm, x: Optional[np.ndarray],
     return partition
 
 
-def read_gmsh(path: Union[str, Path], comm: MPI.Comm, gdim: int = 3,
+def read_gmsh(path: Union[str, Path], comm: MPI.Comm, gdim: Optional[int] = None,
               balance_facets: Optional[Sequence[str]] = None):
     """Mesh, cell tags, facet tags and ``{dim: {name: tag}}`` of a .msh file.
 
-    ``balance_facets`` names physical facet groups (the contact surfaces)
+    ``gdim`` is by default the mesh's own (2 for a mesh in the plane z = 0,
+    :func:`model_dimension`). ``balance_facets`` names physical facet groups (the contact surfaces)
     whose adjacent cells every rank should get an equal share of
     (:func:`model_to_mesh`).
 

@@ -24,10 +24,11 @@ from dolfinx_mortar.io.xdmf_series import XdmfSeries
 FloatArray = npt.NDArray[np.float64]
 
 
-def surface_output_path(path: Path) -> Path:
-    """The slave-surface file next to a bulk output file: ``run.xdmf`` → ``run_slave.xdmf``."""
+def surface_output_path(path: Path, name: str = "slave") -> Path:
+    """The slave-surface file next to a bulk output file: ``run.xdmf`` → ``run_slave.xdmf``
+    (``run_<name>.xdmf``)."""
     path = Path(path)
-    return path.with_name(path.stem + "_slave" + path.suffix)
+    return path.with_name(f"{path.stem}_{name}{path.suffix}")
 
 
 class SlaveSurfaceOutput:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 from mpi4py import MPI
@@ -79,6 +80,31 @@ def test_quickstart_runs_and_balances(tmp_path, monkeypatch):
     assert force[1] > 0 and abs(force[0]) < 1e-6 * force[1]
     reaction = reaction_force(scene["problem"], scene["facet_tags"], scene["TOP"])
     assert reaction == pytest.approx(-force, rel=1e-8, abs=1e-10 * force[1])
+
+
+def test_stack_of_blocks_every_interface_carries_the_load(tmp_path, monkeypatch):
+    """Three contact terms in one problem, as printed in the README: every
+    interface carries the whole load (to Newton's tolerance; the ground, the
+    only support, to round-off), and each term writes its own file, named by
+    the term's name."""
+    import runpy
+    from dolfinx_mortar import read_xdmf_series
+    workdir = MPI.COMM_WORLD.bcast(str(tmp_path), root=0)
+    monkeypatch.chdir(workdir)
+    scene = runpy.run_path(str(DEMOS / "stack_of_blocks.py"))
+    load = scene["load"]
+    assert scene["forces"]["ground"] == pytest.approx(load, rel=1e-13)
+    for name in ("lower", "upper"):
+        assert scene["forces"][name] == pytest.approx(load, rel=1e-10)
+    folder = Path(workdir) / "results"
+    for name, (x0, x1, *_) in zip(("ground", "lower", "upper"), scene["BLOCKS"]):
+        data = read_xdmf_series(folder / f"stack_of_blocks_{name}.xdmf")
+        _, p_hat = data.field("p_hat")
+        # the pressure on that term's slave facets: the load over the block's width
+        # on average, peaking at the edge of the block above
+        mean = load / (x1 - x0)
+        assert 0.5 * mean < p_hat[-1].max() < 10 * mean
+    assert not (folder / "stack_of_blocks_slave.xdmf").exists()
 
 
 def test_press_and_slide_frictionless_sliding_needs_no_tangential_force(out):

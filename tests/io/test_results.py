@@ -1,5 +1,6 @@
-"""Results a user can take away: the pressure with its coordinates, exact zeros off the
-slave surface in the output, and output files other users can read."""
+"""Results a user can take away: the pressure and the friction read-outs with their
+coordinates, exact zeros off the slave surface in the output, and output files other users
+can read."""
 from __future__ import annotations
 
 import os
@@ -11,7 +12,8 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar import ContactProblem, RigidPlane, SurfacePressure, read_xdmf_series
+from dolfinx_mortar import (ContactProblem, CoulombFriction, RigidPlane, SurfaceFriction,
+                            SurfacePressure, read_xdmf_series)
 from dolfinx_mortar.io.output import write_json
 from support.meshes import rectangle
 
@@ -19,12 +21,14 @@ TRACTION = 0.01
 N_CELLS = (8, 4)
 
 
-def pressed_block(degree: int) -> ContactProblem:
-    """[0,1]×[0,0.5] pressed by a uniform traction onto the plane y = 0: p = TRACTION."""
+def pressed_block(degree: int, shear: float = 0.0, friction=None) -> ContactProblem:
+    """[0,1]×[0,0.5] pressed by a uniform traction onto the plane y = 0: p = TRACTION
+    (sheared by ``shear`` too)."""
     domain, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, N_CELLS, bottom=1, top=2, left=3)
     V = fem.functionspace(domain, ("Lagrange", degree, (2,)))
     return ContactProblem(V, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), E=1.0, nu=0.3,
-                          penalty=1e4, fixed={3: {0: 0.0}}, tractions={2: [0.0, -TRACTION]})
+                          penalty=1e4, fixed={3: {0: 0.0}}, tractions={2: [shear, -TRACTION]},
+                          friction=friction)
 
 
 def shared_folder(tmp_path_factory, name: str) -> Path:
@@ -52,6 +56,44 @@ def test_surface_pressure_has_the_bottom_nodes_and_their_coordinates(degree):
     gathered_by_index = dict(zip(everything.global_index.tolist(), everything.p.tolist()))
     assert all(gathered_by_index[g] == p for g, p in zip(mine.global_index.tolist(),
                                                            mine.p.tolist()))
+
+
+def test_friction_read_outs_have_the_bottom_nodes_and_their_coordinates():
+    """surface_friction gives q_A and the stick/slip state with the nodes'
+    coordinates, as surface_pressure gives p_A: each rank's part and the
+    gathered whole hold the layout arrays' values at the same nodes."""
+    mu = 0.15
+    problem = pressed_block(1, shear=0.2 * TRACTION, friction=CoulombFriction(mu))
+    problem.solve(load_steps=2)
+    results = problem.contact.results
+    everything = results.surface_friction(gather=True)
+    assert isinstance(everything, SurfaceFriction)
+    pressure = problem.surface_pressure(gather=True)
+    n = N_CELLS[0] + 1
+    assert everything.x.shape == (n, 2) and everything.q.shape == (n, 2)
+    assert everything.stick_slip.shape == (n,)
+    assert np.array_equal(everything.x, pressure.x)
+    assert np.array_equal(everything.global_index, pressure.global_index)
+    assert np.all(np.diff(everything.x[:, 0]) > 0)
+    # every node presses; the shear makes some stick and some slip, along x only
+    assert set(everything.stick_slip.tolist()) == {1, 2}, everything.stick_slip
+    assert np.all(np.abs(everything.q[:, 1]) < 1e-12 * TRACTION)
+    slipping = everything.stick_slip == 2
+    assert np.allclose(np.abs(everything.q[slipping, 0]), mu * pressure.p[slipping], rtol=1e-9)
+    assert np.all(np.abs(everything.q[:, 0]) <= mu * pressure.p * (1 + 1e-9))
+    # this rank's part: the layout arrays' values at its owned surface nodes
+    mine = results.surface_friction()
+    q, states = results.tangential_tractions(), results.slip_states()
+    layout = problem.contact.slave.layout
+    local = {g: i for i, g in enumerate(layout.global_indices[:layout.num_owned].tolist())}
+    rows = [local[g] for g in mine.global_index.tolist()]
+    assert np.array_equal(mine.q, q[rows]) and np.array_equal(mine.stick_slip, states[rows])
+    assert MPI.COMM_WORLD.allreduce(len(rows)) == n
+    by_index = dict(zip(everything.global_index.tolist(), everything.q[:, 0].tolist()))
+    assert all(by_index[g] == v for g, v in zip(mine.global_index.tolist(),
+                                                 mine.q[:, 0].tolist()))
+    with pytest.raises(ValueError, match="no friction"):
+        pressed_block(1).contact.results.surface_friction()
 
 
 def pressed_box(degree: int) -> ContactProblem:

@@ -10,7 +10,7 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.kinds import parse_kind
+from dolfinx_mortar.kinds import kind_name, parse_kind
 from dolfinx_mortar.contact.obstacles import RigidPlane
 from dolfinx_mortar import (ContactProblem, ContactTerm, LoadPathSolver,
                             NonlinearContactProblem)
@@ -60,10 +60,26 @@ def test_non_integer_tags_are_reported():
         problem(V, tags, tractions={1.5: [0.0, -0.01]})
 
 
-def test_kind_names_in_any_case():
-    assert parse_kind("gls") == parse_kind("GLS")
-    assert parse_kind("Dual") == parse_kind("LcLS*")
-    assert parse_kind("lcls") == parse_kind("LcLS")
+def test_kind_names_are_exact():
+    """A name in another case is refused, naming the valid kinds: "LcLs" was
+    taken for LcLS though it is as near to LcLS*."""
+    assert parse_kind("dual") == parse_kind("LcLS*")
+    assert parse_kind("standard") == parse_kind("LmLS*")
+    assert parse_kind("weighted") == parse_kind("LmLS")
+    for name in ("GLS", "GLS*", "LmLS", "LmLS*", "LcLS*", "LcLS"):
+        assert kind_name(parse_kind(name)) == name
+    with pytest.raises(ValueError, match=r"'LcLs' \(did you mean 'LcLS\*' or 'LcLS'\? "
+                                         r"case matters\); valid kinds are 'GLS', 'GLS\*'.*"
+                                         r"'dual' \(LcLS\*\)"):
+        parse_kind("LcLs")
+    for near_miss in ("gls", "Dual", "lcls*", "LMLS", "GLS* "):
+        with pytest.raises(ValueError, match="did you mean"):
+            parse_kind(near_miss)
+    with pytest.raises(ValueError, match="unknown mortar basis kind 'mortar'; valid"):
+        parse_kind("mortar")
+    V, tags = block()
+    with pytest.raises(ValueError, match=r"did you mean 'GLS' or 'GLS\*'"):
+        problem(V, tags, kind="gls")
 
 
 def test_nearly_incompressible_linear_elements_warn_of_locking():
