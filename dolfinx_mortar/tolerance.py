@@ -1,11 +1,14 @@
 """The geometric tolerance, in one place for the kernels and the Python layer.
 
 Every decision "is this length, area or distance zero?" is taken against
-``GEOMETRIC_TOLERANCE × length scale``, where the length scale is the larger
-of the coordinates' magnitude and the geometry's extent (docs/DESIGN.md, §Tolerances): the
-round-off in a computed length grows with the first, and differs from one CPU
-to the next, so a computed float is never compared with exact zero or with a
-tolerance relative to itself. The constant is the C++ kernels' own
+``GEOMETRIC_TOLERANCE × length scale``, where the length scale is the
+geometry's own extent, its bounding-box diagonal (docs/DESIGN.md,
+§Tolerances). It does not grow with the distance from the origin: the
+kernels take every decision in coordinates relative to a local origin (a
+cell's first node), where round-off is a few 1e-16 of the cells' size, so a
+scene shifted far from the origin keeps its decisions. A computed float is
+never compared with exact zero or with a tolerance relative to itself. The
+constant is the C++ kernels' own
 (``kernels/include/dolfinx_mortar/geometric_tolerance.h``).
 """
 from __future__ import annotations
@@ -23,7 +26,7 @@ GEOMETRIC_TOLERANCE: float = _kernels.geometric_tolerance
 
 
 def length_scale(x: npt.ArrayLike, comm: Optional[MPI.Comm] = None) -> float:
-    """Largest coordinate magnitude or bounding-box diagonal of points ``x``.
+    """Bounding-box diagonal of points ``x`` (their extent; 0 for one point).
 
     With ``comm`` the scale is taken over every rank's points, so that a
     decision does not depend on how the mesh is partitioned.
@@ -33,16 +36,15 @@ def length_scale(x: npt.ArrayLike, comm: Optional[MPI.Comm] = None) -> float:
         raise ValueError(f"points must have shape (points, gdim), got {x.shape}")
     if comm is None or comm.size == 1:
         return float(_kernels.length_scale(np.ascontiguousarray(x))) if len(x) else 0.0
-    # the bounding box and magnitude over all ranks (a rank may hold no point)
+    # the bounding box over all ranks (a rank may hold no point)
     gdim = x.shape[1]
     lo = x.min(axis=0) if len(x) else np.full(gdim, np.inf)
     hi = x.max(axis=0) if len(x) else np.full(gdim, -np.inf)
     lo = np.min(comm.allgather(lo), axis=0)
     hi = np.max(comm.allgather(hi), axis=0)
-    magnitude = comm.allreduce(float(np.abs(x).max()) if len(x) else 0.0, op=MPI.MAX)
     if not np.all(np.isfinite(lo)):
-        return magnitude
-    return max(magnitude, float(np.linalg.norm(hi - lo)))
+        return 0.0
+    return float(np.linalg.norm(hi - lo))
 
 
 def zero_length(scale: float) -> float:

@@ -106,6 +106,14 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     layout = NodeLayout(comm, index_map.size_local, index_map.ghosts)
     gdim = mesh.geometry.dim
     x = space.tabulate_dof_coordinates()[:, :gdim]
+    geometry_dofs = dolfinx_compat.geometry_dofmap(mesh)
+    if geometry_dofs.shape[1] == dof_layout.num_dofs and len(cell_dofs):
+        # The space's nodes are the geometry's (same Lagrange degree, same local order):
+        # take their coordinates as given. Tabulated ones are pushed forward from the
+        # reference cell, off by round-off of |x| (1.5e-8 at 1e8), which is no round-off
+        # of a small scene far from the origin (docs/DESIGN.md, §Tolerances).
+        x = x.copy()
+        x[cell_dofs.ravel()] = mesh.geometry.x[geometry_dofs.ravel(), :gdim]
     facet_cell = _FACET_CELL[mesh.topology.cell_type.name]
     surface = LagrangeSurface(facet_cell, degree, x, cells, layout=layout,
                               quadratic_transform=quadratic_transform,
@@ -113,7 +121,6 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     if len(cells) == 0:
         return surface
     # Outward: the facet normal must point away from its cell's centroid.
-    geometry_dofs = dolfinx_compat.geometry_dofmap(mesh)
     cell_centres = mesh.geometry.x[geometry_dofs[cell_of_facet], :gdim].mean(axis=1)
     facet_centres = x[cells].mean(axis=1)
     normals = surface.cell_normals().mean(axis=1)

@@ -339,7 +339,9 @@ class LagrangeSurface:
         N, dN = self.reference.tabulate(X)
         N_geo, _ = self.reference.tabulate(X, transformed=False)
         coords = self.x[self.cells[cells]]  # (n, nd, gdim)
-        x = np.einsum("nk,nkg->ng", N_geo, coords)
+        origin = coords[:, :1, :]
+        coords = coords - origin            # local: see tabulate
+        x = origin[:, 0, :] + np.einsum("nk,nkg->ng", N_geo, coords)
         tangents = [np.einsum("nk,nkg->ng", dN[:, t, :], coords) for t in range(self.tdim)]
         return N, x, measure_from_tangents(tangents) * self.radial_factor(x)
 
@@ -356,8 +358,12 @@ class LagrangeSurface:
         N, dN = self.reference.tabulate(X, transformed=transformed)
         N_geo, _ = self.reference.tabulate(X, transformed=False)
         coords = self.x[self.cells]  # (nc, nd, gdim)
+        # relative to each cell's first node, so that the tangents' round-off is that of
+        # the cell's size, not of |x| (a facet at 1e8 had |J| off by 1e-5)
+        origin = coords[:, :1, :]
+        coords = coords - origin
         # matmul broadcasts over cells and is several times faster than einsum here
-        points = N_geo @ coords
+        points = origin + N_geo @ coords
         tangents = [dN[:, t, :] @ coords for t in range(self.tdim)]  # (nc, nq, gdim) each
         ds = measure_from_tangents(tangents) * wq[None, :]
         nc, nq = len(self.cells), len(X)

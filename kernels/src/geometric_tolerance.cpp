@@ -22,18 +22,16 @@ length_scale(std::span<const double> x, int gdim)
   std::array<double, 3> lo{ x[0], gdim > 1 ? x[1] : 0.0,
                             gdim > 2 ? x[2] : 0.0 },
     hi = lo;
-  double magnitude = 0;
   for (std::size_t i = 0; i < x.size(); ++i)
   {
     const int k = static_cast<int>(i % gdim);
     lo[k] = std::min(lo[k], x[i]);
     hi[k] = std::max(hi[k], x[i]);
-    magnitude = std::max(magnitude, std::abs(x[i]));
   }
   double diagonal = 0;
   for (int k = 0; k < gdim; ++k)
     diagonal += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-  return std::max(magnitude, std::sqrt(diagonal));
+  return std::sqrt(diagonal);
 }
 
 double

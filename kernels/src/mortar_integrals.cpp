@@ -23,13 +23,18 @@ degenerate_cells(const FacetSurface& s, double zero)
   std::vector<double> nodes(nn * s.gdim);
   std::vector<std::int32_t> out;
   for (std::size_t c = 0; c < s.num_cells(); ++c)
+  {
+    // relative to the first node: round-off of the cell's size, not of |x|
+    gather_cell_nodes(s, c, nodes);
+    for (int i = nn * s.gdim - 1; i >= 0; --i)
+      nodes[i] -= nodes[i % s.gdim];
     for (const auto& piece : facet_subfacets(s.type))
-      if (gather_cell_nodes(s, c, nodes);
-          !make_subfacet<double>(s.type, s.gdim, nodes, piece, zero))
+      if (!make_subfacet<double>(s.type, s.gdim, nodes, piece, zero))
       {
         out.push_back(static_cast<std::int32_t>(c));
         break;
       }
+  }
   return out;
 }
 
@@ -129,8 +134,32 @@ mortar_integrals(const FacetSurface& slave,
   PairAccumulator acc(ns, nm);
   std::vector<double> slave_nodes(ns * gdim), normals(ns * gdim),
     master_nodes(nm * gdim);
-  // Each cell's flat pieces, built when a candidate first meets it: most
-  // candidates are rejected, and building the pieces was half their cost.
+  // Every pair is segmented in coordinates relative to a local origin, its
+  // slave cell's first node, so that round-off scales with the cells' size,
+  // not with their distance from the origin (docs/DESIGN.md, §Tolerances): a
+  // scene shifted by 1e8 gives the pairs and integrals of the scene at the
+  // origin. Axisymmetric integrals weigh by the radius, which a shift in r
+  // would change: there only z is shifted.
+  auto local_origin = [&](const FacetSurface& s, std::size_t c)
+  {
+    Vec3<double> o = { 0.0, 0.0, 0.0 };
+    for (int k = options.axisymmetric ? 1 : 0; k < gdim; ++k)
+      o[k] = s.x[s.cells[c * facet_num_nodes(s.type)] * gdim + k];
+    return o;
+  };
+  auto gather_local = [&](const FacetSurface& s,
+                          std::size_t c,
+                          const Vec3<double>& o,
+                          std::span<double> nodes)
+  {
+    gather_cell_nodes(s, c, nodes);
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      nodes[i] -= o[i % gdim];
+  };
+  // Each cell's flat pieces, built when a candidate first meets it, in the
+  // frame of its own local origin: most candidates are rejected, and
+  // building the pieces was half their cost. A master cell's pieces are
+  // translated into the slave cell's frame for each pair.
   std::vector<std::optional<std::vector<SubFacet<double>>>> slave_pieces(
     slave.num_cells()),
     master_pieces(master.num_cells());
@@ -143,6 +172,27 @@ mortar_integrals(const FacetSurface& slave,
     if (!cache[c])
       cache[c] = cell_pieces<double>(s.type, gdim, nodes, zero);
     return *cache[c];
+  };
+  std::vector<double> own_master_nodes(nm * gdim);
+  std::vector<SubFacet<double>> moved_master_pieces;
+  auto master_pieces_in = [&](std::size_t c, const Vec3<double>& o)
+    -> const std::vector<SubFacet<double>>&
+  {
+    const Vec3<double> own = local_origin(master, c);
+    if (!master_pieces[c])
+    {
+      gather_local(master, c, own, own_master_nodes);
+      pieces_of(master_pieces, master, c, own_master_nodes);
+    }
+    const Vec3<double> shift = vec3::sub(own, o);
+    moved_master_pieces = *master_pieces[c];
+    for (SubFacet<double>& piece : moved_master_pieces)
+    {
+      for (Vec3<double>& v : piece.polygon)
+        v = vec3::add(v, shift);
+      piece.centre = vec3::add(piece.centre, shift);
+    }
+    return moved_master_pieces;
   };
   // the slave pieces' projection directions: the nodal normals interpolated
   // at each piece's centre
@@ -186,8 +236,9 @@ mortar_integrals(const FacetSurface& slave,
     if (skip_slave[cs] or skip_master[cm])
       continue;
     acc.reset();
-    gather_cell_nodes(slave, cs, slave_nodes);
-    gather_cell_nodes(master, cm, master_nodes);
+    const Vec3<double> origin = local_origin(slave, cs);
+    gather_local(slave, cs, origin, slave_nodes);
+    gather_local(master, cm, origin, master_nodes);
     for (int a = 0; a < ns; ++a)
       std::copy_n(slave_normals.data() + slave.cells[cs * ns + a] * gdim,
                   gdim,
@@ -200,7 +251,7 @@ mortar_integrals(const FacetSurface& slave,
       std::span<const double>(normals),
       std::span<const double>(master_nodes),
       slave_pieces_of(cs, slave_nodes),
-      pieces_of(master_pieces, master, cm, master_nodes),
+      master_pieces_in(cm, origin),
       points,
       weights,
       zero,

@@ -10,15 +10,19 @@ namespace dolfinx_mortar
 /// The one relative tolerance of every geometric decision (degenerate facet,
 /// point on an edge, zero-area overlap). A length is zero when it is below
 /// geometric_tolerance times the geometry's length scale (length_scale()).
-/// Round-off in a computed length is a few 1e-16 of the coordinates'
-/// magnitude and differs between CPUs; facets a millionth of their
-/// neighbours' size are real input. 1e-10 sits between the two with margin
-/// on both sides, so no decision depends on where round-off lands.
+/// Decisions are taken in coordinates relative to a local origin (a cell's
+/// first node), where round-off in a computed length is a few 1e-16 of the
+/// cells' size, whatever their distance from the origin; facets a
+/// millionth of their neighbours' size are real input. 1e-10 sits between
+/// the two with margin on both sides, so no decision depends on where
+/// round-off lands.
 inline constexpr double geometric_tolerance = 1e-10;
 
 /// The length scale of a set of points (x: (points, gdim), row-major): the
-/// larger of the largest coordinate magnitude and the bounding box diagonal.
-/// Round-off in lengths grows with the first, real sizes with the second.
+/// bounding box diagonal, the geometry's extent. Not its distance from the
+/// origin: a scene shifted by 1e8 has the tolerance of the scene at the
+/// origin (the kernels compute in local coordinates, so round-off does not
+/// grow with |x| either).
 double
 length_scale(std::span<const double> x, int gdim);
 

@@ -25,6 +25,13 @@ dot(const Vec3<T>& a, const Vec3<T>& b)
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
+/// a + b
+template<Scalar T>
+Vec3<T>
+add(const Vec3<T>& a, const Vec3<T>& b)
+{
+  return { a[0] + b[0], a[1] + b[1], a[2] + b[2] };
+}
 /// a − b
 template<Scalar T>
 Vec3<T>
