@@ -136,11 +136,10 @@ class RangeChecks:
         force. A penalty 1000 times too low penetrated by 5.5% of an element
         without a word.
 
-        A load-path driver calls it at the end of a solve; it checks the
-        nodes off the slave surface too (:meth:`warn_if_the_body_passed_through`),
-        which this check, on the slave nodes' ``p_A/ε``, does not see.
+        A load-path driver calls it at the end of a solve, and
+        :meth:`warn_if_the_body_passed_through` for the nodes off the slave
+        surface, which this check, on the slave nodes' ``p_A/ε``, does not see.
         """
-        self.warn_if_the_body_passed_through()
         ratio, depth, x = deepest
         if ratio <= PENALTY_PENETRATION:
             return

@@ -161,3 +161,44 @@ def _owned_node_coordinates(V: fem.FunctionSpace) -> np.ndarray:
     sums.destroy()
     return x
 
+
+
+#: a rigid motion that a bulk matrix resists by less than this fraction of its
+#: own scale is free (only the contact can hold it)
+FREE_MOTION = 1e-6
+
+
+def free_rigid_motions(A: PETSc.Mat, modes: list[PETSc.Vec],
+                       free_dofs: np.ndarray) -> list[PETSc.Vec]:
+    """The combinations of rigid-body ``modes`` that the bulk matrix ``A``
+    does not resist: an orthonormal basis of the ``r`` in their span with
+    ``|A r| ≤ FREE_MOTION·|A|``.
+
+    A Dirichlet row of A (``free_dofs`` 0 there, 1 elsewhere: the owned
+    entries) is a unit row, and counts what ``r`` moves at its dof at A's
+    scale; a spring in the user's form counts as it stiffens. The modes must
+    be orthonormal (:func:`rigid_body_modes`). Used to decide whether only
+    the contact can hold a body (:class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`).
+    Collective.
+    """
+    scale = A.norm(PETSc.NormType.NORM_INFINITY)
+    images = []
+    for r in modes:
+        y = A.createVecLeft()
+        A.mult(r, y)
+        y.array[:] = np.where(free_dofs > 0.5, y.array_r, scale * r.array_r)
+        images.append(y)
+    gram = np.array([[a.dot(b) for b in images] for a in images]) / scale ** 2
+    values, vectors = np.linalg.eigh(gram)
+    free = []
+    for value, c in zip(values, vectors.T):
+        # the Gram matrix squares |A r|/|A|, and its eigenvalues are exact to
+        # 1e-16 of the largest (about 1): 1e-12 is far above their round-off
+        if value > FREE_MOTION ** 2:
+            continue
+        motion = modes[0].duplicate()
+        motion.set(0.0)
+        for ck, r in zip(c, modes):
+            motion.axpy(ck, r)
+        free.append(motion)
+    return free

@@ -185,8 +185,7 @@ def describe_failure(snes: PETSc.SNES, test: EquilibriumTest,
     if test.cause is not None:   # stopped by the test itself: its words say more
         return test.cause
     if evaluation_error is not None:
-        return (f"{name}: the residual could not be evaluated at a Newton iterate "
-                f"(the step deformed the contact surfaces too far): {evaluation_error}")
+        return f"{name}: the residual could not be evaluated at a Newton iterate: {evaluation_error}"
     if reason == _SNES.DIVERGED_LINEAR_SOLVE:
         ksp = snes.getKSP()
         return (f"{name}: linear solve failed: KSP "

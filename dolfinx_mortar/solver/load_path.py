@@ -21,7 +21,7 @@ from typing import Callable, Optional, Union
 import numpy as np
 from petsc4py import PETSc
 
-from dolfinx_mortar.input_checks import unused_petsc_options
+from dolfinx_mortar.input_checks import collective_checks, unused_petsc_options
 from dolfinx_mortar.io.contact_output import ContactOutput
 from dolfinx_mortar.solver.convergence import (ContactDivergenceError, EquilibriumTest,
                                                FailedAttempt, describe_failure)
@@ -214,8 +214,9 @@ class LoadPathSolver:
         stepper = LoadStepper(load_steps, max_cuts)
         self.equilibrium.force_scale = 0.0
         u = self.problem.u
-        if not np.all(np.isfinite(u.x.array)):
-            raise ValueError("the displacement contains NaN or infinite values")
+        with collective_checks(self.comm):
+            if not np.all(np.isfinite(u.x.array)):
+                raise ValueError("the displacement contains NaN or infinite values")
         writer = ContactOutput(Path(output), u, self.contacts) if output is not None else None
         result = SolveResult()
         failures: list[FailedAttempt] = []
@@ -297,6 +298,7 @@ class LoadPathSolver:
                         on_step(step)
                 for term, worst in zip(self.contacts, deepest):
                     term.checks.warn_if_the_penalty_is_low(worst)
+                    term.checks.warn_if_the_body_passed_through()
             finally:
                 if bar is not None:
                     bar.close()

@@ -30,16 +30,13 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.errors import DegenerateGeometryError
+from dolfinx_mortar.io.contact_output import output_names
 from dolfinx_mortar.contact.term import ContactTerm
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.input_checks import checked_contact_terms, load_data, non_finite_input
 from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 
-
-#: a rigid motion that the bulk matrix resists by less than this fraction of
-#: its own scale is free (only the contact can hold it)
-FREE_MOTION = 1e-6
 
 
 class NonlinearContactProblem:
@@ -79,6 +76,8 @@ class NonlinearContactProblem:
         self._snes: Optional[PETSc.SNES] = None
         self.bcs = list(bcs)
         self.contacts = checked_contact_terms(u, contact)
+        # two terms whose output files would clash are refused now, not at output
+        output_names(self.contacts)
         fc = form_compiler_options or {}
         jit = jit_options or {}
         self.L = fem.form(F, form_compiler_options=fc, jit_options=jit)
@@ -103,6 +102,7 @@ class NonlinearContactProblem:
         self._offered: Optional[tuple[np.ndarray, PETSc.Vec]] = None
         #: why the last :meth:`F` could not be evaluated (its residual is NaN), or None
         self.evaluation_error: Optional[str] = None
+        self.non_finite_load = False
         #: the library's line search of :attr:`solver` (None where the user chose one)
         self.line_search: Optional[FullStepFirst] = None
 
@@ -156,6 +156,8 @@ class NonlinearContactProblem:
         # inside the contact's evaluation at the NaN iterate that followed
         iterate_finite, self.evaluation_error = non_finite_input(
             self.u.function_space.mesh.comm, x, self._load_data)
+        #: whether the last :meth:`F` found a NaN or infinite load (collective)
+        self.non_finite_load = iterate_finite and self.evaluation_error is not None
         if not iterate_finite:
             with b.localForm() as local:
                 local.set(np.nan)
@@ -174,7 +176,7 @@ class NonlinearContactProblem:
             for term in self.contacts:
                 term.assemble_residual(b, self.bcs)
         except DegenerateGeometryError as error:
-            self.evaluation_error = str(error)
+            self.evaluation_error = f"the step deformed the contact surfaces too far: {error}"
             with b.localForm() as local:
                 local.set(np.nan)
             return
@@ -246,36 +248,12 @@ class NonlinearContactProblem:
         return total.norm()
 
     def free_rigid_motions(self, A: PETSc.Mat) -> list[PETSc.Vec]:
-        """The rigid motions of the bodies that the bulk matrix ``A`` (with
-        the Dirichlet rows) does not resist: an orthonormal basis of the
-        combinations ``r`` of :meth:`near_nullspace`'s (orthonormal) modes
-        with ``|A r| ≤ FREE_MOTION·|A|`` (a Dirichlet row counts ``r`` at its
-        dof, at A's scale; a spring in the user's form counts as it
-        stiffens). Collective."""
-        modes = list(self.near_nullspace().getVecs())
-        scale = A.norm(PETSc.NormType.NORM_INFINITY)
-        free_dofs = self.contacts[0].mask(self.bcs).array_r
-        images = []
-        for r in modes:
-            y = A.createVecLeft()
-            A.mult(r, y)
-            # a Dirichlet row's 1 on the diagonal: what the mode moves there, at A's scale
-            y.array[:] = np.where(free_dofs > 0.5, y.array_r, scale * r.array_r)
-            images.append(y)
-        gram = np.array([[a.dot(b) for b in images] for a in images]) / scale ** 2
-        values, vectors = np.linalg.eigh(gram)
-        free = []
-        for value, c in zip(values, vectors.T):
-            # |A r| below 1e-6 of A's scale: the Gram matrix squares it, and
-            # its eigenvalues are exact to 1e-16 of the largest (about 1)
-            if value > FREE_MOTION ** 2:
-                continue
-            motion = modes[0].duplicate()
-            motion.set(0.0)
-            for ck, r in zip(c, modes):
-                motion.axpy(ck, r)
-            free.append(motion)
-        return free
+        """The rigid motions of the bodies that the bulk matrix ``A`` (with the
+        Dirichlet rows) does not resist
+        (:func:`~dolfinx_mortar.linalg.near_nullspace.free_rigid_motions`). Collective."""
+        from dolfinx_mortar.linalg.near_nullspace import free_rigid_motions
+        return free_rigid_motions(A, list(self.near_nullspace().getVecs()),
+                                  self.contacts[0].mask(self.bcs).array_r)
 
     def contact_rows(self) -> np.ndarray:
         """Global indices of this rank's rows that the contact terms stiffened
