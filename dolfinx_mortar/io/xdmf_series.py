@@ -31,6 +31,13 @@ its pointer. Both readers get a grid without a mesh from that. The index
 names the W3C namespace ``http://www.w3.org/2001/XInclude`` and a pointer to
 the mesh grid's ``Topology`` and ``Geometry``.
 
+DOLFINx (0.9) writes the float data items without ``Precision``, so XDMF
+readers take XDMF's default of 4 bytes and ParaView showed the double
+coordinates and values rounded to single precision (3e-8 of the largest
+coordinate). The index declares them ``NumberType="Float" Precision="8"`` (Xdmf3 reads
+the precision only with the type): the data are doubles
+(a float32 mesh's are converted up by HDF5, exactly).
+
 Rank 0 alone writes the index and prepares the folder; each of these steps is
 a collective decision (:func:`dolfinx_mortar.io.output.on_rank0`): if it
 fails, every rank raises the same error instead of waiting in a collective.
@@ -96,7 +103,8 @@ class XdmfSeries:
         self._series: dict[str, tuple[dict, list[str]]] = {}
 
         def first_index() -> None:
-            self._mesh = [_text(grid, 2) for grid in ET.parse(scratch).getroot().find("Domain")]
+            self._mesh = [_text(_double(grid), 2)
+                          for grid in ET.parse(scratch).getroot().find("Domain")]
             scratch.unlink()
             self._publish([self.path.with_suffix(".h5")])
         on_rank0(self.comm, first_index, f"XDMF series {self.path}: writing the mesh's index")
@@ -149,7 +157,7 @@ class XdmfSeries:
                 for item in grid.iter("DataItem"):
                     if item.get("Format") == "HDF":
                         item.text = f"{self.steps.name}/{item.text.strip()}"
-                grids.append(_text(grid, 3))
+                grids.append(_text(_double(grid), 3))
 
     def _publish(self, data_files: Sequence[Path]) -> None:
         """Make the new data durable, then swap in the new index (rank 0)."""
@@ -165,6 +173,16 @@ class XdmfSeries:
             f.write("".join(text))
             f.flush()
             os.fsync(f.fileno())
+
+
+def _double(grid: ET.Element) -> ET.Element:
+    """Declare the float data of a grid double (module doc); returns ``grid``."""
+    for item in grid.iter("DataItem"):
+        if (item.get("Format") == "HDF" and item.get("NumberType", "Float") == "Float"
+                and "Precision" not in item.attrib):
+            item.set("NumberType", "Float")   # Xdmf3 reads Precision only with it
+            item.set("Precision", "8")
+    return grid
 
 
 def _text(element: ET.Element, level: int) -> str:

@@ -91,3 +91,20 @@ def test_xdmf3_pointers_select_the_mesh(series):
                     f"{index}: {pointer} selects {[e.tag for e in selected]}"
                 assert all(e.getparent() is mesh for e in selected)
     MPI.COMM_WORLD.barrier()
+
+
+def test_index_declares_the_data_as_stored(series):
+    """Without NumberType and Precision, XDMF readers take 4-byte floats: ParaView showed
+    the double coordinates and values rounded to single precision."""
+    import h5py
+    if MPI.COMM_WORLD.rank == 0:
+        for index in series:
+            for item in etree.parse(str(index)).iter("DataItem"):
+                filename, _, dataset = item.text.strip().partition(":")
+                with h5py.File(index.parent / filename, "r") as f:
+                    stored = f[dataset].dtype
+                if stored.kind == "f":
+                    declared = (item.get("NumberType"), item.get("Precision"))
+                    assert declared == ("Float", str(stored.itemsize)), \
+                        f"{index}: {item.text.strip()} is {stored}, declared {declared}"
+    MPI.COMM_WORLD.barrier()
