@@ -2,6 +2,8 @@
 waiting in a collective): rank 0 alone prepares the folder and writes the index of an
 XDMF series (dolfinx_mortar.io.xdmf_series, dolfinx_mortar.io.output.on_rank0).
 
+A gmsh file that rank 0 cannot read raises on every rank too.
+
 The unwritable places stop root too (a chmod does not): a path under a regular
 file, and sysfs, where nobody creates files."""
 from __future__ import annotations
@@ -83,3 +85,16 @@ def test_index_that_cannot_be_replaced_raises_on_every_rank(tmp_path_factory):
     errors = errors_on_every_rank(lambda: series.write([u], 1.0))
     assert len(set(errors)) == 1, errors
     assert errors[0][0] == "IsADirectoryError" and "u.xdmf" in errors[0][1], errors[0]
+
+
+def test_gmsh_file_that_does_not_parse_raises_on_every_rank(tmp_path_factory):
+    """Rank 0 alone opens the file (dolfinx_mortar.io.gmsh_io.read_gmsh)."""
+    from dolfinx_mortar.io.gmsh_io import read_gmsh
+    folder = shared_folder(tmp_path_factory, "gmsh")
+    if comm.rank == 0:
+        (folder / "broken.msh").write_text("$MeshFormat\nnot a mesh\n")
+    comm.barrier()
+    with pytest.raises(RuntimeError) as info:
+        read_gmsh(folder / "broken.msh", comm, gdim=2)
+    errors = comm.allgather(str(info.value))
+    assert len(set(errors)) == 1 and "broken.msh" in errors[0], errors
