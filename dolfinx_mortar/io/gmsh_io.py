@@ -17,6 +17,7 @@ import numpy as np
 from mpi4py import MPI
 
 from dolfinx_mortar import dolfinx_compat
+from dolfinx_mortar.io.output import on_rank0
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
 
@@ -154,12 +155,14 @@ def read_gmsh(path: Union[str, Path], comm: MPI.Comm, gdim: Optional[int] = None
         raise FileNotFoundError(f"no gmsh file at {path}")
     gmsh.initialize(["", "-v", "0"])
     try:
-        names = None
-        if comm.rank == 0:
+        names: dict = {}
+
+        def read() -> None:
             gmsh.open(str(path))
-            names = {}
             for dim, tag in gmsh.model.getPhysicalGroups():
                 names.setdefault(dim, {})[gmsh.model.getPhysicalName(dim, tag)] = tag
+        # a file gmsh cannot read raises on every rank, not on rank 0 alone
+        on_rank0(comm, read, f"gmsh file {path}")
         names = comm.bcast(names)
         tags = None
         if balance_facets is not None:

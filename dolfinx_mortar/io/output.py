@@ -2,6 +2,10 @@
 
 Every result is written to a temporary file in the target folder and renamed
 into place, so an interrupted run never leaves a truncated JSON, CSV or PNG.
+
+A file-system step that one rank does for all (:func:`on_rank0`) is a
+collective decision: when it fails, every rank raises the same error, none is
+left waiting for the others in a barrier.
 """
 from __future__ import annotations
 
@@ -46,6 +50,47 @@ def replacing(path: PathLike, suffix: str = "") -> Iterator[str]:
         if os.path.exists(tmp):
             os.remove(tmp)
         raise
+
+
+def on_rank0(comm: Any, action: Callable[[], None], what: str) -> None:
+    """Run ``action()`` on rank 0 of ``comm``; every rank returns, or every rank raises.
+
+    Collective: the other ranks wait until rank 0 is done (as at a barrier). An error of
+    rank 0 is raised on all ranks: an ``OSError`` as the ``OSError`` of the same errno (so
+    ``PermissionError``, ``NotADirectoryError``, ... with the path it names), any other
+    exception as a ``RuntimeError``; the message starts with ``what``.
+
+    Parameters
+    ----------
+    comm
+        The mpi4py communicator of the ranks that go on together.
+    action
+        The file-system step.
+    what
+        What the step is for, naming its file, e.g. ``"XDMF series run.xdmf: index"``.
+    """
+    failure: Optional[BaseException] = None
+    report = None
+    if comm.rank == 0:
+        try:
+            action()
+        except Exception as err:
+            failure = err
+            if isinstance(err, OSError) and err.errno is not None:
+                report = ("os", err.errno, f"{what}: {err.strerror}", err.filename)
+            else:
+                report = ("other", f"{what}: {type(err).__name__}: {err}")
+    report = comm.bcast(report, root=0)
+    if report is None:
+        return
+    if report[0] == "os":
+        _, number, message, filename = report
+        # OSError(errno, ...) is the subclass of that errno (PermissionError, ...)
+        error: Exception = (OSError(number, message, filename) if filename is not None
+                            else OSError(number, message))
+    else:
+        error = RuntimeError(report[1])
+    raise error from failure
 
 
 def write_atomically(path: PathLike, write: Callable[[str], None]) -> Path:

@@ -20,9 +20,31 @@ So here no file that the index names is ever opened for writing again:
 A kill at any moment leaves the previous or the new index, each naming only
 closed files. DOLFINx's own index of each file is a scratch file
 (``*.xdmf-partial``) merged into the real index and deleted.
+
+Every step's grid takes the mesh's ``Topology`` and ``Geometry`` from the
+index's first grid through ``<xi:include xpointer=...>``. DOLFINx (0.9, 0.11)
+writes that include in the namespace ``https://www.w3.org/2001/XInclude``,
+which libxml2's XInclude (ParaView's legacy XDMF reader, lxml) does not know,
+and a pointer to ``/Xdmf/Domain/*`` that selects nothing in the index; Xdmf3
+(ParaView's XDMF3 readers) takes any element named ``include`` and evaluates
+its pointer. Both readers get a grid without a mesh from that. The index
+names the W3C namespace ``http://www.w3.org/2001/XInclude`` and a pointer to
+the mesh grid's ``Topology`` and ``Geometry``.
+
+DOLFINx (0.9) writes the float data items without ``Precision``, so XDMF
+readers take XDMF's default of 4 bytes and ParaView showed the double
+coordinates and values rounded to single precision (3e-8 of the largest
+coordinate). The index declares them ``NumberType="Float" Precision="8"`` (Xdmf3 reads
+the precision only with the type): the data are doubles
+(a float32 mesh's are converted up by HDF5, exactly).
+
+Rank 0 alone writes the index and prepares the folder; each of these steps is
+a collective decision (:func:`dolfinx_mortar.io.output.on_rank0`): if it
+fails, every rank raises the same error instead of waiting in a collective.
 """
 from __future__ import annotations
 
+import errno
 import os
 import shutil
 import xml.etree.ElementTree as ET
@@ -33,9 +55,12 @@ from xml.sax.saxutils import quoteattr
 from dolfinx import fem, io
 from dolfinx import mesh as dmesh
 
-from dolfinx_mortar.io.output import replacing
+from dolfinx_mortar.io.output import on_rank0, replacing
 
+#: the W3C XInclude namespace, the one libxml2 (so ParaView, lxml) resolves
 XINCLUDE = "http://www.w3.org/2001/XInclude"
+#: the namespaces DOLFINx has written its includes in (0.9, 0.11: https)
+DOLFINX_XINCLUDES = (XINCLUDE, "https://www.w3.org/2001/XInclude")
 #: the mesh is the first uniform grid of the index, as DOLFINx's default
 MESH_POINTER = ("xpointer(/Xdmf/Domain/Grid[@GridType='Uniform'][1]"
                 "/*[self::Topology or self::Geometry])")
@@ -66,27 +91,37 @@ class XdmfSeries:
         self.comm = mesh.comm
         self.steps = steps_folder(self.path)
         self.count = 0
-        if self.comm.rank == 0:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            # an earlier series here is replaced: its index goes first, so that
-            # no index ever names the files removed or overwritten next
-            self.path.unlink(missing_ok=True)
-            for stale in self.path.parent.glob(f".{self.path.name}.*.tmp"):
-                stale.unlink(missing_ok=True)
-            shutil.rmtree(self.steps, ignore_errors=True)
-            self.steps.mkdir()
-        self.comm.barrier()
+        on_rank0(self.comm, self._prepare_folder,
+                 f"XDMF series {self.path}: preparing its folder")
         scratch = self.path.with_suffix(".xdmf-partial")   # its data file: <stem>.h5
         with io.XDMFFile(self.comm, str(scratch), "w") as f:
             f.write_mesh(mesh)
         self.comm.barrier()
-        if self.comm.rank == 0:
-            # the index's text is kept in pieces, one per grid: serializing
-            # the whole tree at every step made 200 steps 3× slower
-            self._mesh = [_text(grid, 2) for grid in ET.parse(scratch).getroot().find("Domain")]
-            self._series: dict[str, tuple[dict, list[str]]] = {}
+        # the index's text is kept in pieces, one per grid: serializing
+        # the whole tree at every step made 200 steps 3× slower
+        self._mesh: list[str] = []
+        self._series: dict[str, tuple[dict, list[str]]] = {}
+
+        def first_index() -> None:
+            self._mesh = [_text(_double(grid), 2)
+                          for grid in ET.parse(scratch).getroot().find("Domain")]
             scratch.unlink()
             self._publish([self.path.with_suffix(".h5")])
+        on_rank0(self.comm, first_index, f"XDMF series {self.path}: writing the mesh's index")
+
+    def _prepare_folder(self) -> None:
+        """Make the folder; remove an earlier series at this path (rank 0)."""
+        parent = self.path.parent
+        if parent.exists() and not parent.is_dir():   # mkdir would say "File exists"
+            raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(parent))
+        parent.mkdir(parents=True, exist_ok=True)
+        # an earlier series here is replaced: its index goes first, so that
+        # no index ever names the files removed or overwritten next
+        self.path.unlink(missing_ok=True)
+        for stale in parent.glob(f".{self.path.name}.*.tmp"):
+            stale.unlink(missing_ok=True)
+        shutil.rmtree(self.steps, ignore_errors=True)
+        self.steps.mkdir()
 
     def write(self, functions: Sequence[fem.Function], t: float) -> None:
         """Add the functions at time t (collective); on return the index names them."""
@@ -98,10 +133,13 @@ class XdmfSeries:
                 f.write_function(u, t, mesh_xpath="/Xdmf/Domain")
         # every rank's part of the .h5 is written and the file closed
         self.comm.barrier()
-        if self.comm.rank == 0:
+
+        def index() -> None:
             self._merge(ET.parse(scratch).getroot())
             scratch.unlink()
             self._publish([scratch.with_suffix(".h5")])
+        on_rank0(self.comm, index,
+                 f"XDMF series {self.path}: writing the index of step {self.count}")
 
     def _merge(self, step: ET.Element) -> None:
         """Move the step's grids into the index, naming its data file from
@@ -109,12 +147,17 @@ class XdmfSeries:
         for series in step.find("Domain").findall("Grid"):
             _, grids = self._series.setdefault(series.get("Name"), (dict(series.attrib), []))
             for grid in series.findall("Grid"):
-                for include in grid.iter(f"{{{XINCLUDE}}}include"):
-                    include.set("xpointer", MESH_POINTER)
+                includes = [e for e in grid.iter()
+                            if e.tag in {f"{{{ns}}}include" for ns in DOLFINX_XINCLUDES}]
+                if len(includes) != 1:
+                    raise RuntimeError(f"DOLFINx wrote {len(includes)} XIncludes of the mesh "
+                                       f"in a grid of '{series.get('Name')}', not 1")
+                includes[0].tag = f"{{{XINCLUDE}}}include"
+                includes[0].set("xpointer", MESH_POINTER)
                 for item in grid.iter("DataItem"):
                     if item.get("Format") == "HDF":
                         item.text = f"{self.steps.name}/{item.text.strip()}"
-                grids.append(_text(grid, 3))
+                grids.append(_text(_double(grid), 3))
 
     def _publish(self, data_files: Sequence[Path]) -> None:
         """Make the new data durable, then swap in the new index (rank 0)."""
@@ -130,6 +173,16 @@ class XdmfSeries:
             f.write("".join(text))
             f.flush()
             os.fsync(f.fileno())
+
+
+def _double(grid: ET.Element) -> ET.Element:
+    """Declare the float data of a grid double (module doc); returns ``grid``."""
+    for item in grid.iter("DataItem"):
+        if (item.get("Format") == "HDF" and item.get("NumberType", "Float") == "Float"
+                and "Precision" not in item.attrib):
+            item.set("NumberType", "Float")   # Xdmf3 reads Precision only with it
+            item.set("Precision", "8")
+    return grid
 
 
 def _text(element: ET.Element, level: int) -> str:
