@@ -24,6 +24,11 @@ from dolfinx_mortar import _kernels
 #: relative tolerance of every geometric decision (the kernels' constant)
 GEOMETRIC_TOLERANCE: float = _kernels.geometric_tolerance
 
+#: a facet edge this much shorter than the largest facet around its nodes is a
+#: meshing artifact: its nodes share one averaged normal (the kernels' constant;
+#: dolfinx_mortar.mortar.coupling.normal_clusters)
+NEGLIGIBLE_FACET_RATIO: float = _kernels.negligible_facet_ratio
+
 
 def length_scale(x: npt.ArrayLike, comm: Optional[MPI.Comm] = None) -> float:
     """Bounding-box diagonal of points ``x`` (their extent; 0 for one point).

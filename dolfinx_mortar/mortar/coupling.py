@@ -74,15 +74,20 @@ def current_coordinates(surface: LagrangeSurface,
     return surface.x + u
 
 
-def averaged_nodal_normals(surface: LagrangeSurface, x: FloatArray) -> FloatArray:
+def averaged_nodal_normals(surface: LagrangeSurface, x: FloatArray,
+                           clusters: Optional[dict[int, int]] = None) -> FloatArray:
     """Unit averages of the adjacent cells' normals at every local node.
 
     Each cell's normal is weighted by its size (|J| at the node: the length
     of a P1 line, twice the area of a P1 triangle), so that a facet of
     vanishing size, as mesh generators make at corners, cannot tilt its
     nodes' normals (unweighted, a 1e-6 h facet at 45° tilted them by 22°).
-    Nodes on no cell get a zero vector. Summed across ranks, so a node shared
-    by facets on two ranks gets the same normal on both.
+    Nodes joined by such a facet share one normal, that of all the cells
+    around any of them (``clusters``, default :func:`normal_clusters` of
+    ``x``): a node whose only facet is a vanishing chamfer at the surface's
+    corner takes the surface's normal, not the chamfer's 45° (which put its
+    pressure 8-40% off). Nodes on no cell get a zero vector. Summed across
+    ranks, so a node shared by facets on two ranks gets the same normal on both.
     """
     cell_normals = _kernels.element_node_normals(surface.facet_type, x,
                                                  surface.cells.astype(np.int32),
@@ -90,14 +95,87 @@ def averaged_nodal_normals(surface: LagrangeSurface, x: FloatArray) -> FloatArra
     summed = np.column_stack([surface.layout.sum_at_functions(surface.cells,
                                                               cell_normals[..., k])
                               for k in range(x.shape[1])])
+    if clusters is None:
+        clusters = normal_clusters(surface, x)
+    summed = sum_over_clusters(surface, clusters, summed)
     length = np.linalg.norm(summed, axis=1)
     return np.divide(summed, length[:, None], out=np.zeros_like(summed),
                      where=length[:, None] > 0)  # exactly 0 only on nodes of no cell
 
 
+def normal_clusters(surface: LagrangeSurface, x: FloatArray) -> dict[int, int]:
+    """The nodes that share one averaged normal: global id → the smallest
+    global id of its cluster, for the nodes of a cluster only.
+
+    Two nodes of a cell closer than ``NEGLIGIBLE_FACET_RATIO`` times the
+    largest cell around them (dolfinx_mortar/tolerance.py) are one cluster:
+    the facet between them is a meshing artifact, not a feature. Decided by
+    the kernel on the gathered surface (collective), so the same on every
+    rank and the same as the current configuration's exact derivatives.
+    """
+    copy = gather_surface(surface, x)
+    ids = copy.global_ids.astype(np.int64)
+    roots = _kernels.normal_clusters(surface.facet_type, copy.x, copy.cells, ids)
+    members = np.isin(roots, roots[roots != ids])
+    return dict(zip(ids[members].tolist(), roots[members].tolist()))
+
+
+def cluster_diameters(surface: LagrangeSurface, clusters: dict[int, int],
+                      diameters: FloatArray) -> FloatArray:
+    """Each local cell's diameter, or for a cell touching a cluster the largest
+    diameter of the cells around that cluster: a facet that is a meshing
+    artifact (a corner chamfer 1e-6 h long) searches as far as the surface
+    around it, not a millionth of that (it found no master in the current
+    configuration). Collective."""
+    if not clusters:
+        return diameters
+    layout = surface.layout
+    nn = surface.cells.shape[1]
+    largest = sum_over_clusters(surface, clusters, np.zeros((layout.size_local, 0)),
+                                maxima=np.repeat(diameters[:, None], nn, axis=1))
+    return np.maximum(diameters, largest[surface.cells].max(axis=1))
+
+
+def sum_over_clusters(surface: LagrangeSurface, clusters: dict[int, int],
+                      values: FloatArray, maxima: Optional[FloatArray] = None
+                      ) -> FloatArray:
+    """Nodal totals (local nodes, k), each node of a cluster given the sum over
+    its cluster's nodes. With ``maxima`` (local cells, nodes per cell), instead
+    the largest of these cell values around each cluster (0 off the clusters).
+    Collective (a cluster may span ranks)."""
+    if not clusters:                 # the same on every rank
+        return values
+    layout = surface.layout
+    ids = layout.global_indices
+    in_cluster = np.isin(ids, np.fromiter(clusters, dtype=np.int64))
+    roots = np.array([clusters[int(i)] for i in ids[in_cluster]], dtype=np.int64)
+    if maxima is not None:
+        # every local cell's value at its nodes of a cluster (cells are owned once)
+        cell_ids = ids[surface.cells]
+        at = np.isin(cell_ids, np.fromiter(clusters, dtype=np.int64))
+        mine = (np.array([clusters[int(i)] for i in cell_ids[at]], dtype=np.int64),
+                np.asarray(maxima)[at])
+    else:
+        owned = np.flatnonzero(in_cluster) < layout.num_owned   # each node counted once
+        mine = (roots[owned], values[in_cluster][owned])
+    parts = layout.comm.allgather(mine)
+    all_roots = np.concatenate([r for r, _ in parts])
+    cluster_ids, which = np.unique(all_roots, return_inverse=True)
+    if maxima is not None:
+        result = np.zeros(len(cluster_ids))
+        np.maximum.at(result, which.ravel(), np.concatenate([v for _, v in parts]))
+        out = np.zeros(layout.size_local)
+    else:
+        result = np.zeros((len(cluster_ids),) + values.shape[1:])
+        np.add.at(result, which.ravel(), np.concatenate([v for _, v in parts]))
+        out = values.copy()
+    out[in_cluster] = result[np.searchsorted(cluster_ids, roots)]
+    return out
+
+
 def interface_nodal_normals(slave: LagrangeSurface, slave_normals: FloatArray,
-                            master: SurfaceCopy, pairs: npt.NDArray, areas: FloatArray
-                            ) -> FloatArray:
+                            master: SurfaceCopy, pairs: npt.NDArray, areas: FloatArray,
+                            clusters: Optional[dict[int, int]] = None) -> FloatArray:
     """Unit bisectors of each slave node's normal and the normal of the master opposite it.
 
     Where two curved bodies touch, their deformed surfaces coincide, and the common normal
@@ -110,7 +188,10 @@ def interface_nodal_normals(slave: LagrangeSurface, slave_normals: FloatArray,
 
     The master normal opposite node A is the mean of the normals of the master facets paired
     with A's slave facets, weighted by the paired areas, summed over all ranks. Nodes without
-    a master keep their own normal.
+    a master keep their own normal. The nodes of a cluster (:func:`normal_clusters`)
+    share one opposite normal, over the pairs of all their cells: a node whose only
+    facet is a vanishing one sees the master beyond its neighbours, not the
+    master's own vanishing facet opposite.
 
     Parameters
     ----------
@@ -123,6 +204,8 @@ def interface_nodal_normals(slave: LagrangeSurface, slave_normals: FloatArray,
     pairs, areas
         (slave cell, master cell) of every pair and its covered area, from a segmentation
         along ``slave_normals``.
+    clusters
+        The slave's :func:`normal_clusters` (default: none).
     """
     gdim = slave_normals.shape[1]
     pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
@@ -144,6 +227,9 @@ def interface_nodal_normals(slave: LagrangeSurface, slave_normals: FloatArray,
     paired_area = slave.layout.sum_at_functions(
         slave_cells, np.repeat(np.asarray(areas, dtype=np.float64)[:, None],
                                slave_cells.shape[1], axis=1))
+    # a cluster's nodes share their normal: they face the master of all its cells
+    summed = sum_over_clusters(slave, clusters, np.column_stack([opposite, paired_area]))
+    opposite, paired_area = summed[:, :gdim], summed[:, gdim]
     length = np.linalg.norm(opposite, axis=1)
     usable = (slave.layout.on_cells(slave_cells)
               & (length > GEOMETRIC_TOLERANCE * paired_area))
@@ -306,7 +392,8 @@ class MortarCoupling:
         comm = slave.layout.comm
         xs = current_coordinates(slave, slave_displacement)
         xm = current_coordinates(master, master_displacement)
-        self.normals = averaged_nodal_normals(slave, xs)
+        clusters = normal_clusters(slave, xs)
+        self.normals = averaged_nodal_normals(slave, xs, clusters)
         master_copy = gather_surface(master, xm)
         self.timings["normals_and_gather"] = time.perf_counter() - clock
         clock = time.perf_counter()
@@ -316,7 +403,8 @@ class MortarCoupling:
         self.master_cells = master_copy.cells
 
         # each slave facet's diameter (its largest coordinate extent)
-        diameters = np.max(np.ptp(xs[slave.cells], axis=1), axis=1, initial=0.0)
+        diameters = cluster_diameters(
+            slave, clusters, np.max(np.ptp(xs[slave.cells], axis=1), axis=1, initial=0.0))
         if search_radius is None:
             search_radius = comm.allreduce(float(np.max(diameters, initial=0.0)), op=MPI.MAX)
         if not np.isfinite(search_radius) or search_radius < 0:
@@ -365,7 +453,7 @@ class MortarCoupling:
             # pairing and gap along the interface normals, not the facets' own
             self._raise_on_degenerate_facets(r, xs, slave_cells, master_copy)
             self.normals = interface_nodal_normals(slave, self.normals, master_copy,
-                                                   r.pairs, r.area)
+                                                   r.pairs, r.area, clusters)
             r = segment(self.normals, keep_points, True)
         self._raise_on_degenerate_facets(r, xs, slave_cells, master_copy)
         self.timings["segmentation"] = time.perf_counter() - clock

@@ -49,6 +49,7 @@ PYBIND11_MODULE(_kernels, m)
   bind_current_surface(m);
 
   m.attr("geometric_tolerance") = geometric_tolerance;
+  m.attr("negligible_facet_ratio") = negligible_facet_ratio;
   m.def(
     "length_scale",
     [](const array_t& x)

@@ -370,6 +370,27 @@ bind_segmentation(py::module_& m)
     py::arg("ids"),
     py::arg("node"),
     "The averaged unit normal at a node with its exact derivatives");
+
+  m.def(
+    "normal_clusters",
+    [](FacetType type,
+       const array_t& x,
+       const int_array_t& cells,
+       const int64_array_t& ids)
+    {
+      auto s = surface_view(type, x, cells);
+      std::vector<std::int64_t> root = normal_clusters(
+        s, std::span<const std::int64_t>(ids.data(), ids.size()));
+      return py::array_t<std::int64_t>(static_cast<py::ssize_t>(root.size()),
+                                       root.data());
+    },
+    py::arg("facet_type"),
+    py::arg("x"),
+    py::arg("cells"),
+    py::arg("ids"),
+    "Per node, the smallest id of the nodes that share its averaged normal "
+    "(joined by a cell edge shorter than negligible_facet_ratio times the "
+    "largest cell around them)");
 }
 
 } // namespace dolfinx_mortar::bindings

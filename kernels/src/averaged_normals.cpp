@@ -9,6 +9,10 @@
 #include <dolfinx_mortar/jet.h>
 #include <dolfinx_mortar/pair_segmentation.h>
 
+#include <dolfinx_mortar/geometric_tolerance.h>
+
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -142,11 +146,29 @@ Adjacency
 node_cells(const FacetSurface& s, std::span<const std::int64_t> ids)
 {
   const int nn = facet_num_nodes(s.type);
-  Adjacency around;
+  Adjacency own;
   for (std::size_t c = 0; c < s.num_cells(); ++c)
     for (int i = 0; i < nn; ++i)
-      around[ids[s.cells[c * nn + i]]].emplace_back(
-        static_cast<std::int32_t>(c), i);
+      own[ids[s.cells[c * nn + i]]].emplace_back(static_cast<std::int32_t>(c),
+                                                 i);
+  // a cluster's nodes share the cells around all of them
+  const std::vector<std::int64_t> cluster = normal_clusters(s, ids);
+  std::unordered_map<std::int64_t, std::vector<std::int64_t>> members;
+  for (std::size_t a = 0; a < cluster.size(); ++a)
+    if (cluster[a] != ids[a])
+      members[cluster[a]].push_back(ids[a]);
+  Adjacency around = own;
+  for (auto& [root, others] : members)
+  {
+    std::sort(others.begin(), others.end());
+    others.erase(std::unique(others.begin(), others.end()), others.end());
+    std::vector<std::pair<std::int32_t, int>> shared = own[root];
+    for (const std::int64_t id : others)
+      shared.insert(shared.end(), own[id].begin(), own[id].end());
+    around[root] = shared;
+    for (const std::int64_t id : others)
+      around[id] = shared;
+  }
   return around;
 }
 
@@ -250,6 +272,77 @@ normal_derivatives(const FacetSurface& s,
 }
 
 } // namespace detail
+
+std::vector<std::int64_t>
+normal_clusters(const FacetSurface& s, std::span<const std::int64_t> ids)
+{
+  s.check();
+  if (ids.size() != s.x.size() / s.gdim)
+    throw std::invalid_argument("one id per surface node expected");
+  const int nn = facet_num_nodes(s.type), gdim = s.gdim;
+  const std::size_t nc = s.num_cells();
+  // the distance of every two nodes of a cell, in coordinates relative to
+  // the cell's first node; the largest is the cell's diameter
+  std::vector<double> nodes(nn * gdim), distance(nc * nn * nn, 0.0);
+  std::unordered_map<std::int64_t, double> largest; // around each id
+  for (std::size_t c = 0; c < nc; ++c)
+  {
+    gather_cell_nodes(s, c, nodes);
+    double diameter = 0;
+    for (int i = 0; i < nn; ++i)
+      for (int j = i + 1; j < nn; ++j)
+      {
+        double d2 = 0;
+        for (int k = 0; k < gdim; ++k)
+        {
+          const double dk = (nodes[j * gdim + k] - nodes[0 * gdim + k]) -
+                            (nodes[i * gdim + k] - nodes[0 * gdim + k]);
+          d2 += dk * dk;
+        }
+        distance[(c * nn + i) * nn + j] = std::sqrt(d2);
+        diameter = std::max(diameter, std::sqrt(d2));
+      }
+    for (int i = 0; i < nn; ++i)
+    {
+      double& h = largest[ids[s.cells[c * nn + i]]];
+      h = std::max(h, diameter);
+    }
+  }
+  // union-find on ids, the smallest id the root (independent of the order
+  // of the cells: the same clusters on every rank of a gathered surface)
+  std::unordered_map<std::int64_t, std::int64_t> parent;
+  auto find = [&](std::int64_t a)
+  {
+    auto it = parent.find(a);
+    while (it != parent.end() && it->second != a)
+    {
+      a = it->second;
+      it = parent.find(a);
+    }
+    return a;
+  };
+  for (std::size_t c = 0; c < nc; ++c)
+    for (int i = 0; i < nn; ++i)
+      for (int j = i + 1; j < nn; ++j)
+      {
+        const std::int64_t a = ids[s.cells[c * nn + i]],
+                           b = ids[s.cells[c * nn + j]];
+        const double h = std::max(largest[a], largest[b]);
+        if (a == b || !(distance[(c * nn + i) * nn + j] <
+                        negligible_facet_ratio * h))
+          continue;
+        const std::int64_t ra = find(a), rb = find(b);
+        if (ra == rb)
+          continue;
+        parent.emplace(ra, ra);
+        parent.emplace(rb, rb);
+        parent[std::max(ra, rb)] = std::min(ra, rb);
+      }
+  std::vector<std::int64_t> root(ids.size());
+  for (std::size_t a = 0; a < ids.size(); ++a)
+    root[a] = find(ids[a]);
+  return root;
+}
 
 NormalDerivatives
 averaged_normal_derivatives(const FacetSurface& s,

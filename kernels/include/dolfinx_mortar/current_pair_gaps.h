@@ -50,7 +50,8 @@ struct NormalDerivatives
   std::vector<double> hessian;    ///< (gdim, star·gdim, star·gdim)
 };
 
-/// The averaged normal at node id @p node of a surface whose nodes carry
+/// The averaged normal at node id @p node (that of its normal_clusters
+/// cluster: the size-weighted normals of the cells around any of its nodes) of a surface whose nodes carry
 /// the global ids @p ids (a gathered surface has one copy of a node per cell;
 /// copies share an id).
 /// @throws std::invalid_argument if no cell holds the node or the summed
@@ -59,6 +60,17 @@ NormalDerivatives
 averaged_normal_derivatives(const FacetSurface& s,
                             std::span<const std::int64_t> ids,
                             std::int64_t node);
+
+/// The cluster of every node of a surface whose nodes carry the global ids
+/// @p ids (copies share an id): two nodes of one cell closer than
+/// negligible_facet_ratio times the largest cell diameter around either are
+/// one cluster, and so transitively. Returns, per surface node, the smallest
+/// id of its cluster (its own id for a node in no cluster). A cluster's nodes
+/// share one averaged normal, that of all the cells around them: a node
+/// whose only cell is a vanishing facet (a corner chamfer 1e-6 h long) takes
+/// the normal of the surface it belongs to, not of the artifact.
+std::vector<std::int64_t>
+normal_clusters(const FacetSurface& s, std::span<const std::int64_t> ids);
 
 /// How current_pair_gaps integrates and what it returns.
 struct PairGapOptions

@@ -18,6 +18,15 @@ namespace dolfinx_mortar
 /// round-off lands.
 inline constexpr double geometric_tolerance = 1e-10;
 
+/// A facet edge this much shorter than the largest facet around its nodes
+/// is a meshing artifact, not a feature: its nodes share one averaged normal
+/// (normal_clusters). A facet a millionth of its neighbours' size at a
+/// corner (as mesh generators leave) otherwise gives a node whose only
+/// facet it is that facet's direction, which the penalty turns into a
+/// pressure 8-40% off at that node. Well above round-off, far below any
+/// grading of a real mesh (neighbouring facets differ by a factor of a few).
+inline constexpr double negligible_facet_ratio = 1e-3;
+
 /// The length scale of a set of points (x: (points, gdim), row-major): the
 /// bounding box diagonal, the geometry's extent. Not its distance from the
 /// origin: a scene shifted by 1e8 has the tolerance of the scene at the
