@@ -82,6 +82,11 @@ class NearContactStiffness:
     are the ones the contact must hold; the near nodes are stiffened only
     if one of them changes their gaps. The decision holds until a node
     penetrates or the next load step starts.
+
+    The gap-closing start (:func:`gap_closing_force`) stiffens them always
+    (:attr:`closing`): it only chooses where Newton starts, and a start at
+    contact keeps an exact Newton from overshooting through the obstacle
+    (the pointwise active set then cycled: a cylinder pressed on a plane).
     """
 
     #: a free motion moves the near nodes' gaps when it changes one by more
@@ -94,13 +99,16 @@ class NearContactStiffness:
         #: None: not decided since the last contact; True: the bulk holds the
         #: body (no stiffness without force); False: only the contact can
         self.bulk_holds: Optional[bool] = None
+        #: inside the gap-closing start: the near nodes stiffen whatever holds the body
+        self.closing = False
 
     def mask(self, model: GapModel, state: ContactState) -> FloatArray:
         """:func:`stiffened_nodes`, with the near nodes stiffened unless the
         bulk holds the body (collective)."""
         if penetrates(model, state):
             self.bulk_holds = None
-        return stiffened_nodes(model, state, near_contact=not self.bulk_holds)
+        return stiffened_nodes(model, state,
+                               near_contact=self.closing or not self.bulk_holds)
 
     def reset(self) -> None:
         """Decide again at the next approach (a new load step)."""

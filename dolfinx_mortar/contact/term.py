@@ -374,11 +374,19 @@ class ContactTerm:
 
     def gap_closing_force(self) -> Optional[PETSc.Vec]:
         """The pull that closes the gaps near contact when nothing touches yet
-        and only the contact can hold the body
         (:func:`~dolfinx_mortar.contact.active_set.gap_closing_force`)."""
-        if self._near_contact.bulk_holds:
-            return None
         return gap_closing_force(self.model, self.state)
+
+    @contextmanager
+    def closing_gaps(self) -> Iterator[None]:
+        """Inside the block the Jacobian stiffens the nodes near contact
+        whatever holds the body: the gap-closing start's linear model
+        (:class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`)."""
+        self._near_contact.closing = True
+        try:
+            yield
+        finally:
+            self._near_contact.closing = False
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
