@@ -363,7 +363,8 @@ class ContactTerm:
         return self._near_contact.mask(self.model, state)
 
     def settle_near_contact(self, free_motions) -> None:
-        """Where nothing touches yet and some node is near contact, decide
+        """Called once per Newton Jacobian, before the contact is assembled.
+        Where nothing touches yet and some node is near contact, decide
         whether those nodes need stiffness without force: only if one of the
         bodies' ``free_motions`` (a callable giving the rigid motions that
         the bulk does not resist, as dof vectors) changes their gaps
