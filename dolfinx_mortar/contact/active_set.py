@@ -79,9 +79,15 @@ class NearContactStiffness:
     motions of the bodies that neither the Dirichlet conditions nor the
     user's form resist (``free``, :meth:`NonlinearContactProblem.free_rigid_motions
     <dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem.free_rigid_motions>`)
-    are the ones the contact must hold; the near nodes are stiffened only
-    if one of them changes their gaps. The decision holds until a node
-    penetrates or the next load step starts.
+    are the ones the contact must hold; from the second Newton Jacobian in
+    a row at which nothing penetrates (:meth:`due`), the near nodes are
+    stiffened only if one of them changes their gaps. The decision holds
+    until a node penetrates or the next load step starts.
+
+    The gap-closing start (:func:`gap_closing_force`) stiffens them always
+    (:attr:`closing`): it only chooses where Newton starts, and a start at
+    contact keeps an exact Newton from overshooting through the obstacle
+    (the pointwise active set then cycled: a cylinder pressed on a plane).
     """
 
     #: a free motion moves the near nodes' gaps when it changes one by more
@@ -94,22 +100,40 @@ class NearContactStiffness:
         #: None: not decided since the last contact; True: the bulk holds the
         #: body (no stiffness without force); False: only the contact can
         self.bulk_holds: Optional[bool] = None
+        #: inside the gap-closing start: the near nodes stiffen whatever holds the body
+        self.closing = False
+        #: Newton Jacobians in a row at which nothing penetrated
+        self.apart = 0
 
     def mask(self, model: GapModel, state: ContactState) -> FloatArray:
         """:func:`stiffened_nodes`, with the near nodes stiffened unless the
         bulk holds the body (collective)."""
-        if penetrates(model, state):
-            self.bulk_holds = None
-        return stiffened_nodes(model, state, near_contact=not self.bulk_holds)
+        return stiffened_nodes(model, state,
+                               near_contact=self.closing or not self.bulk_holds)
 
     def reset(self) -> None:
         """Decide again at the next approach (a new load step)."""
         self.bulk_holds = None
+        self.apart = 0
 
     def due(self, model: GapModel, state: ContactState) -> bool:
-        """Whether a decision is due: nothing penetrates, some node is near
-        contact, nothing decided yet (collective)."""
-        if self.bulk_holds is not None or penetrates(model, state):
+        """Count a Newton Jacobian and say whether a decision is due (collective).
+
+        One is due at the second Jacobian in a row at which nothing
+        penetrates and some node is near contact, if none was taken since
+        the last penetration. The first is stiffened as it always was: an
+        iterate that lost contact for one step (a disk slid over a
+        neo-Hookean block, "previous") is held near the obstacle, and the
+        next one touches again; exact steps there made Newton cycle. A
+        second one in a row is what a solution short of contact looks like.
+        """
+        if self.closing:
+            return False
+        if penetrates(model, state):
+            self.bulk_holds, self.apart = None, 0
+            return False
+        self.apart += 1
+        if self.bulk_holds is not None or self.apart < 2:
             return False
         n = model.slave.layout.num_owned
         near = stiffened_nodes(model, state)[:n]

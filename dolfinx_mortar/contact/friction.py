@@ -54,6 +54,7 @@ from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.kinds import DUAL_KINDS, is_global
 from dolfinx_mortar.layout import MassMatrixSolver, assemble_blocks
 from dolfinx_mortar.linalg.sparse_products import kron_identity, transpose_mat_mult
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
@@ -175,6 +176,30 @@ def _solve_components(mass: MassMatrixSolver, values: FloatArray) -> FloatArray:
     return np.stack([mass.solve(values[:, i]) for i in range(values.shape[1])], axis=1)
 
 
+def _lumped_slave_part(blocks: FloatArray, slave_nodes: int) -> FloatArray:
+    """The scalar slip couplings ``[D̄ | −M̄]`` (cells, rows, columns) with the
+    slave part ``D̄`` lumped onto its diagonal (row sums ``∫ M̄_A`` kept).
+
+    For LmLS and LmLS* ``D̄_AB = ∫ M̄_A N_B`` couples each node to its
+    neighbours (a row-scaled consistent mass, 1/6 : 2/3 : 1/6 on a uniform
+    line), and with it the nodal Coulomb conditions are set on an average of
+    the neighbours' slips. Newton's stick/slip iteration then ran away: on a
+    block pushed sideways at 0.2 of its load (μ = 0.3, ε = 1e3 E/h) the slip
+    of the slipping zone reversed from one iteration to the next, hundreds of
+    stick bands deep, and it stalled at every increment (a first step from
+    rest is the same problem at any load). The dual kinds' D̄ is diagonal
+    already (biorthogonality) and they converged in 4–5 iterations; lumped,
+    LmLS(*) converge in the same (docs/FRICTION.md). The row sums keep the
+    slip objective for rigid translations, and the master part stays the
+    mortar integral.
+    """
+    slave, master = blocks[:, :, :slave_nodes], blocks[:, :, slave_nodes:]
+    diagonal = np.zeros_like(slave)
+    rows = np.arange(slave.shape[1])
+    diagonal[:, rows, rows] = slave.sum(axis=2)
+    return np.concatenate([diagonal, master], axis=2)
+
+
 class Friction:
     """Coulomb friction of one contact term (see the module).
 
@@ -205,6 +230,9 @@ class Friction:
         #: ε_T
         self.penalty = law.penalty(options.penalty)
         self.slave, self.obstacle = slave, obstacle
+        #: LmLS, LmLS*: the slip of a node from its own displacement (see
+        #: :func:`_lumped_slave_part`)
+        self._lumped = options.kind not in DUAL_KINDS and not is_global(options.kind)
         self.comm: MPI.Comm = slave.layout.comm
         u.x.scatter_forward()
         self.history = FrictionHistory(
@@ -258,6 +286,8 @@ class Friction:
 
     def _mortar_operator(self, model: MortarGap, project: bool) -> _SlipOperator:
         cells, cols, blocks = model.pair_operators
+        if self._lumped and project:
+            blocks = _lumped_slave_part(blocks, cells.shape[1])
         projectors = _projectors(model.coupling.normals)
         applied = projectors if project else _identities(projectors)
         return _SlipOperator(self._assemble(model, cells, cols, blocks, applied),
@@ -275,6 +305,8 @@ class Friction:
         normals[nodes] = self.obstacle.gradient(model.slave.x[nodes] + u_nodes[nodes] + back)
         projectors = _projectors(normals)
         blocks = np.einsum("cq,cqa,cqb->cab", tab.weights, model.Mbar, tab.phi)
+        if self._lumped and project:
+            blocks = _lumped_slave_part(blocks, blocks.shape[2])
         nc, nd = cells.shape
         cols = model.node_dofs(cells).reshape(nc, nd * self.slave.gdim)
         mass = self.slave.layout.sum_at_functions(cells, blocks.sum(axis=2))

@@ -363,7 +363,8 @@ class ContactTerm:
         return self._near_contact.mask(self.model, state)
 
     def settle_near_contact(self, free_motions) -> None:
-        """Where nothing touches yet and some node is near contact, decide
+        """Called once per Newton Jacobian, before the contact is assembled.
+        Where nothing touches yet and some node is near contact, decide
         whether those nodes need stiffness without force: only if one of the
         bodies' ``free_motions`` (a callable giving the rigid motions that
         the bulk does not resist, as dof vectors) changes their gaps
@@ -374,11 +375,19 @@ class ContactTerm:
 
     def gap_closing_force(self) -> Optional[PETSc.Vec]:
         """The pull that closes the gaps near contact when nothing touches yet
-        and only the contact can hold the body
         (:func:`~dolfinx_mortar.contact.active_set.gap_closing_force`)."""
-        if self._near_contact.bulk_holds:
-            return None
         return gap_closing_force(self.model, self.state)
+
+    @contextmanager
+    def closing_gaps(self) -> Iterator[None]:
+        """Inside the block the Jacobian stiffens the nodes near contact
+        whatever holds the body: the gap-closing start's linear model
+        (:class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`)."""
+        self._near_contact.closing = True
+        try:
+            yield
+        finally:
+            self._near_contact.closing = False
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since

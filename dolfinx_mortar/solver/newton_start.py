@@ -2,6 +2,7 @@
 gap-closing start for bodies that touch at a point."""
 from __future__ import annotations
 
+from contextlib import ExitStack
 from typing import Optional
 
 from petsc4py import PETSc
@@ -43,15 +44,14 @@ def close_gaps(problem: NonlinearContactProblem, ksp: PETSc.KSP, x: PETSc.Vec) -
     """
     b = problem.vector()
     problem.F(x, b)
-    if all(term.gap_closing_force() is None for term in problem.contacts):
-        return
-    A = problem.matrix()
-    # the Jacobian decides where only the contact can hold the body; only
-    # there is the pull right (NearContactStiffness)
-    problem.J(x, A, ksp)
     pulls = [term.gap_closing_force() for term in problem.contacts]
     if all(p is None for p in pulls):
         return
+    A = problem.matrix()
+    with ExitStack() as stack:
+        for term in problem.contacts:
+            stack.enter_context(term.closing_gaps())
+        problem.J(x, A, ksp)
     rhs = b.copy()
     for pull in pulls:
         if pull is not None:

@@ -2,8 +2,6 @@
 // SPDX-License-Identifier: MIT
 #include <dolfinx_mortar/basis_kind.h>
 
-#include <algorithm>
-#include <cctype>
 #include <string>
 
 #include <stdexcept>
@@ -35,29 +33,22 @@ to_string(BasisKind kind)
 BasisKind
 basis_kind_from_string(std::string_view name)
 {
-  // Case-insensitive: the six names differ beyond case, and users type
-  // "gls" as readily as "dual"; one rule for names and aliases alike.
-  auto lower = [](std::string_view s)
-  {
-    std::string out(s);
-    std::transform(out.begin(), out.end(), out.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    return out;
-  };
-  const std::string key = lower(name);
+  // Exact: "LcLs" is one letter from LcLS* and from LcLS, and matching
+  // without case took it silently for LcLS (issue 35). The Python layer
+  // names the near misses; here an unknown name is refused.
   for (BasisKind kind : all_basis_kinds)
-    if (key == lower(to_string(kind)))
+    if (name == to_string(kind))
       return kind;
-  if (key == "standard")
+  if (name == "standard")
     return BasisKind::LmLS_star;
-  if (key == "weighted")
+  if (name == "weighted")
     return BasisKind::LmLS;
-  if (key == "dual")
+  if (name == "dual")
     return BasisKind::LcLS_star;
   throw std::invalid_argument(
     "unknown mortar basis kind '" + std::string(name) +
     "'; valid kinds are GLS, GLS*, LmLS, LmLS*, LcLS*, LcLS and the "
-    "aliases standard (LmLS*), weighted (LmLS), dual (LcLS*), in any case");
+    "aliases standard (LmLS*), weighted (LmLS), dual (LcLS*), exactly as written");
 }
 
 bool

@@ -163,7 +163,7 @@ def box(obstacle, kind: str, configuration: str = "initial") -> ContactProblem:
 
 
 def first_3d(x):
-    return np.vstack([0.0031 * (x[0] - 0.47), 0.0011 * (x[1] - 0.53),
+    return np.vstack([0.0031 * (x[0] - 0.47), 0.0013 * (x[1] - 0.53),
                       -0.00213 - 0.00397 * x[0]])
 
 

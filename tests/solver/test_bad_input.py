@@ -154,7 +154,7 @@ def test_a_penalty_that_cannot_represent_a_force_is_named():
 
 def test_a_penalty_far_below_e_over_h_is_named():
     V, tags = block()        # h = 1/8 (the slave's elements' bounding-box diagonal)
-    with pytest.raises(ValueError, match=r"the penalty 1e-12 is 1.3e-13 times E/h = 8 "
+    with pytest.raises(ValueError, match=r"the penalty 1e-12 is 1.[23]e-13 times E/h = 8 "
                                          r"\(E = 1, h = 0.125"):
         problem(V, tags, penalty=1e-12)
     problem(V, tags, penalty=1e-6)           # low, but not beyond representing contact
