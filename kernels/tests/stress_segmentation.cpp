@@ -427,9 +427,17 @@ main(int argc, char** argv)
   const std::uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
   Generator g(seed);
   std::map<std::string, long> cases;
+  std::map<std::string, double> worst_by_kind; // |covered − exact| / A_slave
   std::map<std::string, std::map<std::string, long>> failures;
   double worst_over = 0; // largest (covered − slave area) / slave area
   std::string worst_kind;
+  // largest |covered − exact| / slave area, with the pair (hex: exact input
+  // for a regression test) and the number of pairs above 1e-6
+  double worst_error = 0;
+  long above_1e6 = 0;
+  std::string worst_error_kind;
+  std::vector<double> worst_xs, worst_xm;
+  double worst_exact = 0, worst_covered = 0;
   long total_failures = 0;
   const auto start = std::chrono::steady_clock::now();
   for (long i = 0; i < pairs; ++i)
@@ -511,6 +519,24 @@ main(int argc, char** argv)
       fail("covered area differs from the exact one", r.area, exact);
     if (r.area > as + tol)
       fail("covered area above the slave area", r.area, as);
+    // The area error relative to the slave's, where the slave's normal is
+    // known well enough for 1e-6 (its conditioning, the tilt term above, is
+    // not the clipping's)
+    if (as > 0 and tilt * w_max * where.scale * perimeter(c.slave) < 1e-7 * as)
+    {
+      const double error = std::abs(r.area - exact) / as;
+      above_1e6 += error > 1e-6;
+      worst_by_kind[c.kind] = std::max(worst_by_kind[c.kind], error);
+      if (error > worst_error)
+      {
+        worst_error = error;
+        worst_error_kind = c.kind;
+        worst_xs = xs;
+        worst_xm = xm;
+        worst_exact = exact;
+        worst_covered = r.area;
+      }
+    }
     if (as > 0 and (r.area - as) / as > worst_over)
     {
       worst_over = (r.area - as) / as;
@@ -530,19 +556,40 @@ main(int argc, char** argv)
   const double seconds =
     std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
       .count();
-  std::printf("%-26s %9s %9s\n", "category", "cases", "failures");
+  std::printf("%-26s %9s %9s %12s\n",
+              "category",
+              "cases",
+              "failures",
+              "worst err/A");
   for (const auto& [kind, n] : cases)
   {
     long f = 0;
     for (const auto& [what, count] : failures[kind])
       f += count;
-    std::printf("%-26s %9ld %9ld\n", kind.c_str(), n, f);
+    std::printf(
+      "%-26s %9ld %9ld %12.3g\n", kind.c_str(), n, f, worst_by_kind[kind]);
     for (const auto& [what, count] : failures[kind])
       std::printf("    %-46s %9ld\n", what.c_str(), count);
   }
   std::printf("largest covered/slave area excess: %.3g (%s)\n",
               worst_over,
               worst_kind.c_str());
+  std::printf("largest |covered − exact|/slave area: %.3g (%s), %ld pairs "
+              "above 1e-6\n",
+              worst_error,
+              worst_error_kind.c_str(),
+              above_1e6);
+  if (!worst_xs.empty())
+  {
+    std::printf("  covered %a exact %a\n", worst_covered, worst_exact);
+    for (const auto* x : { &worst_xs, &worst_xm })
+    {
+      std::printf("  %s", x == &worst_xs ? "slave " : "master");
+      for (double v : *x)
+        std::printf(" %a", v);
+      std::printf("\n");
+    }
+  }
   std::printf("stress_segmentation: %ld generated pairs, %ld failures, %.1f s "
               "(seed %llu)\n",
               pairs,
