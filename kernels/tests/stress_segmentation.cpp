@@ -25,7 +25,8 @@
 //   - covered ≤ A_slave + the same tolerance;
 //   - a facet degenerate by construction is reported as degenerate, and one
 //     whose height is far above zero_length is not.
-// Usage: stress_segmentation [pairs=1000000] [seed=1]. Prints the failures by
+// Usage: stress_segmentation [pairs=1000000] [seed=1] [category: whose worst
+// pair to print]. Prints the failures by
 // category and exits with 1 on any.
 #include <dolfinx_mortar/geometric_tolerance.h>
 #include <dolfinx_mortar/mortar_integrals.h>
@@ -426,6 +427,8 @@ main(int argc, char** argv)
   const long pairs = argc > 1 ? std::atol(argv[1]) : 1000000;
   const std::uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
   Generator g(seed);
+  // the worst pair printed: of this category only, when given
+  const std::string only_kind = argc > 3 ? argv[3] : "";
   std::map<std::string, long> cases;
   std::map<std::string, double> worst_by_kind; // |covered − exact| / A_slave
   std::map<std::string, std::map<std::string, long>> failures;
@@ -527,7 +530,7 @@ main(int argc, char** argv)
       const double error = std::abs(r.area - exact) / as;
       above_1e6 += error > 1e-6;
       worst_by_kind[c.kind] = std::max(worst_by_kind[c.kind], error);
-      if (error > worst_error)
+      if (error > worst_error and (only_kind.empty() or c.kind == only_kind))
       {
         worst_error = error;
         worst_error_kind = c.kind;
