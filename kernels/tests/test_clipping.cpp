@@ -89,6 +89,26 @@ TEST(Clipping, CrossingPointsStayOnTheirEdge)
   EXPECT_NEAR(signed_area(clip_polygon(subject, clip, tol)), 0.5, 1e-9);
 }
 
+TEST(Clipping, CrossingFromAPointOnTheLineAlongANearlyParallelEdge)
+{
+  // A sliver A(0,0), B(1,0), C(1,h) of height 1e3 tolerances; the clip line
+  // v = c + m·u passes A inside by 0.9 tol (on the line) and C outside by
+  // 9 tol: it crosses the nearly parallel edge A–C at u = 1/11, 0.09 of the
+  // edge away from A, and B–C at Y = (1, c + m). The exact overlap is the
+  // sliver less the triangle X C Y. No crossing was computed from a point on
+  // the line: the band A X Y (0.9 tol wide, 0.9 long) was covered, 8e-4 of
+  // the sliver's area (a sliver and a near-coincident master, seen in the
+  // stress harness up to 1e-2).
+  const double tol = 1e-10, h = 1e3 * tol, c = 0.9 * tol, m = h - 9.9 * tol;
+  const std::vector<Point2> sliver = { { 0, 0 }, { 1, 0 }, { 1, h } };
+  const std::vector<Point2> clip = { { -1, c - m }, { 0.5, -1 }, { 2, c + 2 * m } };
+  ASSERT_GT(signed_area(clip), 0);
+  const double u_x = c / (h - m);
+  const double exact = h / 2 - 0.5 * (h - c - m) * (1 - u_x);
+  const double area = signed_area(clip_polygon(sliver, clip, tol));
+  EXPECT_LE(std::abs(area - exact), 1e-6 * h / 2) << area << " " << exact;
+}
+
 TEST(BoundingBoxTree, MatchesBruteForce)
 {
   std::vector<double> a, b;

@@ -31,10 +31,13 @@ signed_area(const std::vector<std::array<T, 2>>& polygon)
 
 /// Intersection of a polygon with a convex, counter-clockwise clip polygon
 /// (Sutherland–Hodgman). Points within @p tolerance of a clip edge's line are
-/// on it: kept, and never the end of a crossing, so touching edges, shared
-/// vertices and parallel edges need no special case and every crossing point
-/// lies on its edge; consecutive points closer than @p tolerance are merged.
-/// The area is then exact up to @p tolerance times the perimeter.
+/// on it: kept, so touching edges, shared vertices and parallel edges need no
+/// special case. A crossing is computed only between points on opposite sides
+/// (by value) of which at least one lies beyond the tolerance, so every
+/// crossing point lies on its edge and is well conditioned; consecutive
+/// points closer than @p tolerance are merged. The area is then exact up to
+/// @p tolerance times the perimeter, and only where an edge lies within the
+/// tolerance of the line along its whole length.
 ///
 /// T is double or a Jet: every decision is taken on the values, so both
 /// take the same branches and the Jet's vertices carry the derivatives of
@@ -66,14 +69,13 @@ clip_polygon(const std::vector<std::array<T, 2>>& subject,
     { return (ex * (p[1] - a[1]) - ey * (p[0] - a[0])) / length; };
     input.swap(output);
     output.clear();
-    // Points within the tolerance of the line are on it: kept, and never
-    // the end of a crossing. A crossing is computed only between points
-    // strictly on opposite sides beyond the tolerance, so t lies in (0, 1)
-    // and the crossing point on the edge p–q. (Classifying with the
-    // tolerance but intersecting without it put t outside [0, 1] for a
-    // point "inside" by tolerance yet outside in fact: crossing points
-    // extrapolated off the edge, and near-coincident facets covered up to
-    // 80 times the slave's area.)
+    // Points within the tolerance of the line are on it: kept. A crossing
+    // is computed only between points on opposite sides, at least one beyond
+    // the tolerance, so t lies in (0, 1) and the crossing point on the edge
+    // p–q. (Classifying with the tolerance but intersecting without it put
+    // t outside [0, 1] for a point "inside" by tolerance yet outside in
+    // fact: crossing points extrapolated off the edge, and near-coincident
+    // facets covered up to 80 times the slave's area.)
     auto classify = [tolerance](double s)
     { return s > tolerance ? 1 : (s < -tolerance ? -1 : 0); };
     const std::size_t n = input.size();
@@ -85,7 +87,13 @@ clip_polygon(const std::vector<std::array<T, 2>>& subject,
       const int cp = classify(value(sp)), cq = classify(value(sq));
       if (cp >= 0)
         output.push_back(p);
-      if (cp * cq < 0)
+      // A crossing also from a point on the line (within the tolerance) to
+      // one beyond it on the other side: along a nearly parallel edge it
+      // may lie far from the point on the line, and leaving it out dropped
+      // (or kept) a band up to the tolerance wide and the edge long. The
+      // ends differ by more than the tolerance, so t is well conditioned.
+      if ((cp * cq < 0) or (cp == 0 and cq < 0 and value(sp) > 0) or
+          (cq == 0 and cp < 0 and value(sq) > 0))
       {
         const T t = sp / (sp - sq);
         output.push_back(
