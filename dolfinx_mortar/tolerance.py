@@ -26,7 +26,7 @@ GEOMETRIC_TOLERANCE: float = _kernels.geometric_tolerance
 
 #: a facet edge this much shorter than the largest facet around its nodes is a
 #: meshing artifact: its nodes share one averaged normal (the kernels' constant;
-#: dolfinx_mortar.mortar.coupling.normal_clusters)
+#: dolfinx_mortar.mortar.surface_normals.normal_clusters)
 NEGLIGIBLE_FACET_RATIO: float = _kernels.negligible_facet_ratio
 
 
