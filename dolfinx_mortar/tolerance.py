@@ -50,3 +50,26 @@ def length_scale(x: npt.ArrayLike, comm: Optional[MPI.Comm] = None) -> float:
 def zero_length(scale: float) -> float:
     """The length below which a length is zero for a geometry of ``scale``."""
     return max(GEOMETRIC_TOLERANCE * scale, np.finfo(np.float64).tiny)
+
+
+def local_origin(x: npt.ArrayLike, comm: Optional[MPI.Comm] = None,
+                 axisymmetric: bool = False) -> npt.NDArray[np.float64]:
+    """A point to measure a geometry's coordinates from: the lower corner of
+    the bounding box of points ``x`` (over every rank with ``comm``, so that
+    every rank takes the same; the origin if there is no point).
+
+    ``X − origin`` is exact or rounded at the extent's scale, and ``(X −
+    origin) + u`` keeps the digits of a displacement ``u`` that ``X + u``
+    loses far from the origin (at |X| = 1e6, 1e-10 of every position: a
+    tenth of a per mille of a 1e-5 gap). Translations change no gap, normal or
+    derivative, so the geometry can be computed there. Axisymmetric: only the
+    axis coordinate moves (r is the radius of 2πr).
+    """
+    x = np.asarray(x, dtype=np.float64)
+    lo = x.min(axis=0) if len(x) else np.full(x.shape[1], np.inf)
+    if comm is not None and comm.size > 1:
+        lo = np.min(comm.allgather(lo), axis=0)
+    lo = np.where(np.isfinite(lo), lo, 0.0)
+    if axisymmetric:
+        lo[0] = 0.0
+    return lo
