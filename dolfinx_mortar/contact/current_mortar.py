@@ -102,6 +102,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
             raise ValueError("slave and master must share one displacement space (one mesh)")
         super().__init__(slave, kind, law)
         self.master, self.search_radius = master, search_radius
+        # both surfaces relative to the slave's origin (CurrentSurfaceGap.origin)
+        self._local_slave, self._local_master = slave.moved(-self.origin), master.moved(
+            -self.origin)
         degree = polynomial_degree(slave) + max(polynomial_degree(slave),
                                                  polynomial_degree(master))
         self.segment_points, self.segment_weights = segment_quadrature(slave.tdim, degree)
@@ -146,7 +149,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
         compute any rank's pairs, as every rank holds both gathered surfaces.
         Collective (the slave surface is gathered at u)."""
         slave = self.slave
-        copy = gather_surface(slave, slave.x + u_nodes)
+        copy = gather_surface(slave, self.local_x + u_nodes)
         master = coupling.master_copy
         return _kernels.current_pair_gaps(
             slave.facet_type, copy.x, copy.cells, copy.global_ids.astype(np.int64),
@@ -163,7 +166,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # the pairs are found again at every evaluation, and only those near
         # contact matter: each facet searches two of its own diameters
         # (unless the user set a radius), not the largest facet's
-        coupling = MortarCoupling(slave.moved(u_nodes), self.master.moved(u_nodes),
+        coupling = MortarCoupling(self._local_slave.moved(u_nodes),
+                                  self._local_master.moved(u_nodes),
                                   search_radius=self.search_radius,
                                   facet_search_factor=(FACET_SEARCH_FACTOR
                                                        if self.search_radius is None

@@ -14,7 +14,7 @@ from petsc4py import PETSc
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.contact.finite_deformation import (CurrentSurfaceGap, ObstaclePoints,
                                                        SourceGaps)
-from dolfinx_mortar.contact.obstacles import RigidObstacle
+from dolfinx_mortar.contact.obstacles import RigidObstacle, relative_to
 from dolfinx_mortar.contact.penalty_law import PenaltyLaw
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import assemble_blocks
@@ -43,9 +43,11 @@ class CurrentObstacleGap(CurrentSurfaceGap):
         points = np.einsum("qb,cbi->cqi", self.N, x)
         nc, nq, gdim = points.shape
         flat = points.reshape(-1, gdim)
-        return ObstaclePoints(-self.obstacle.signed_distance(flat).reshape(nc, nq),
-                              -self.obstacle.gradient(flat).reshape(nc, nq, gdim),
-                              -self.obstacle.hessian(flat).reshape(nc, nq, gdim, gdim))
+        # the points are relative to the origin, and so is the obstacle as it is now
+        obstacle = relative_to(self.obstacle, self.origin)
+        return ObstaclePoints(-obstacle.signed_distance(flat).reshape(nc, nq),
+                              -obstacle.gradient(flat).reshape(nc, nq, gdim),
+                              -obstacle.hessian(flat).reshape(nc, nq, gdim, gdim))
 
     def _gap(self, u_nodes: FloatArray, W: FloatArray,
              cells: _kernels.SurfaceCellDerivatives) -> SourceGaps:

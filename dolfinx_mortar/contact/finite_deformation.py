@@ -48,6 +48,7 @@ from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, is_global, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.linalg.sparse_products import transpose_mat_mult
+from dolfinx_mortar.tolerance import local_origin
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -140,6 +141,10 @@ class CurrentSurfaceGap(GapModelBase):
                 "slave facet and its linearization is not implemented; use a local kind")
         super().__init__(slave, law)
         self.kind = kind
+        #: the geometry is computed relative to this point, so that x − o + u keeps
+        #: u's digits far from the origin (translations change no gap or derivative)
+        self.origin = local_origin(slave.x, slave.layout.comm, slave.axisymmetric)
+        self.local_x = slave.x - self.origin
         ref = slave.reference
         affine = ref.degree == 1 and ref.cell in ("interval", "triangle")
         if self.kind in DUAL_KINDS and not affine:
@@ -195,11 +200,12 @@ class CurrentSurfaceGap(GapModelBase):
     def _cells_at(self, u_nodes: FloatArray
                   ) -> tuple[FloatArray, Optional[ObstaclePoints],
                              _kernels.SurfaceCellDerivatives]:
-        """The slave cells' current nodes, an obstacle's gap at their points, and
+        """The slave cells' current nodes (relative to :attr:`origin`), an
+        obstacle's gap at their points, and
         W = ∫ N_a J (with an obstacle also ĝ = ∫ φ_a J d) of every cell with
         exact gradients (the kernels' Jets; the Hessians on demand, in
         :meth:`_cell_hessians`)."""
-        x = np.ascontiguousarray((self.slave.x + u_nodes)[self.slave.cells])
+        x = np.ascontiguousarray((self.local_x + u_nodes)[self.slave.cells])
         obstacle = self._obstacle_at(x)
         extra = obstacle.kernel_arguments() if obstacle is not None else {}
         cells = _kernels.current_surface_cells(

@@ -36,10 +36,11 @@ from dolfinx_mortar.contact.penalty_law import PenaltyLaw
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling
-from dolfinx_mortar.contact.obstacles import RigidObstacle
+from dolfinx_mortar.contact.obstacles import RigidObstacle, relative_to
 from dolfinx_mortar.contact.pointwise import MortarPointGaps, obstacle_positive_gaps
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.linalg.sparse_products import TransposeProduct, transpose_mat_mult
+from dolfinx_mortar.tolerance import local_origin
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -175,8 +176,11 @@ class ObstacleGap(GapModelBase):
         if obstacle.gdim != slave.gdim:
             raise ValueError(f"a {obstacle.gdim}D obstacle cannot touch a {slave.gdim}D body")
         self.obstacle = obstacle
-        self.tabulation = slave.tabulate(quadrature_degree or 2 * slave.reference.degree + 2,
-                                         transformed=False)
+        #: the points are relative to this point (and the obstacle with them), so that
+        #: φ keeps the local digits far from the origin (tolerance.local_origin)
+        self.origin = local_origin(slave.x, slave.layout.comm, slave.axisymmetric)
+        self.tabulation = slave.moved(-self.origin).tabulate(
+            quadrature_degree or 2 * slave.reference.degree + 2, transformed=False)
         tab = self.tabulation
         #: M̄_A at the quadrature points, per cell: (cells, points, functions)
         self.Mbar = np.einsum("cqb,cba->cqa", tab.phi, self.coefficients_std)
@@ -212,7 +216,8 @@ class ObstacleGap(GapModelBase):
         return assemble_blocks(self.dofs, local, self.dofs, dofs, blocks)
 
     def nodal_gaps(self, u_nodes: FloatArray) -> tuple[FloatArray, PETSc.Mat, FloatArray]:
-        """Nodal gaps, G, and the obstacle Hessian data at the quadrature points.
+        """Nodal gaps, G, and the current quadrature points (relative to
+        :attr:`origin`).
 
         ``u_nodes``: displacement at the local slave-layout nodes, (nodes, gdim).
         """
@@ -222,8 +227,9 @@ class ObstacleGap(GapModelBase):
         u_q = np.einsum("cqb,cbk->cqk", tab.phi, u_nodes[cells])
         x = (tab.points + u_q).reshape(-1, self.slave.gdim)
         nc, nq, nd = tab.phi.shape
-        d = -self.obstacle.signed_distance(x).reshape(nc, nq)
-        nu = self.obstacle.gradient(x).reshape(nc, nq, self.slave.gdim)
+        obstacle = relative_to(self.obstacle, self.origin)
+        d = -obstacle.signed_distance(x).reshape(nc, nq)
+        nu = obstacle.gradient(x).reshape(nc, nq, self.slave.gdim)
         wd = tab.weights * d
         gaps = self.slave.layout.sum_at_functions(cells, np.einsum("cqa,cq->ca", self.Mbar, wd))
         # ∂d̄_A/∂u_(B,k) = −Σ_q w M̄_A ν_k N_B
@@ -235,7 +241,7 @@ class ObstacleGap(GapModelBase):
 
     def curvature_blocks(self, coefficients: FloatArray, x: FloatArray) -> Optional[FloatArray]:
         """Element matrices of Σ_A c_A ∂²d̄_A/∂u², or None for a flat obstacle."""
-        H = self.obstacle.hessian(x)
+        H = relative_to(self.obstacle, self.origin).hessian(x)
         # decided on every rank together: the matrix is assembled collectively, and a
         # rank without slave cells sees no curvature (2 ranks of DOLFINx 0.11 hung)
         if not self.slave.layout.comm.allreduce(bool(np.any(H)), op=MPI.LOR):

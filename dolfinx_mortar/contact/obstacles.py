@@ -10,6 +10,7 @@ load-path callback of :class:`~dolfinx_mortar.solver.load_path.LoadPathSolver`).
 """
 from __future__ import annotations
 
+import copy
 from typing import Protocol, Sequence
 
 import numpy as np
@@ -161,3 +162,38 @@ class RigidCylinder(Translatable):
         unit = r / length[:, None]
         P = np.eye(3) - np.outer(self.axis, self.axis)
         return (P[None] - unit[:, :, None] * unit[:, None, :]) / length[:, None, None]
+
+
+class _Shifted:
+    """A user's obstacle seen from ``origin``: evaluated at ``origin + x``."""
+
+    def __init__(self, obstacle: RigidObstacle, origin: FloatArray):
+        self.obstacle, self.origin = obstacle, origin
+        self.gdim = obstacle.gdim
+        self.displacement = obstacle.displacement
+
+    def signed_distance(self, x: FloatArray) -> FloatArray:
+        return self.obstacle.signed_distance(x + self.origin)
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        return self.obstacle.gradient(x + self.origin)
+
+    def hessian(self, x: FloatArray) -> FloatArray:
+        return self.obstacle.hessian(x + self.origin)
+
+
+def relative_to(obstacle: RigidObstacle, origin: FloatArray) -> RigidObstacle:
+    """The obstacle as it is now, in coordinates relative to ``origin``
+    (:func:`~dolfinx_mortar.tolerance.local_origin`).
+
+    The library's obstacles are moved by ``−origin`` (their reference point
+    minus a point near it: exact or rounded at the scene's scale), so that
+    ``|x − c| − R`` keeps the digits of the local size far from the origin (at
+    |x| = 1e6 it loses 1e-10 absolute: 1e-5 of a 1e-5 gap). Another obstacle
+    is evaluated at ``origin + x``, in absolute coordinates as before.
+    """
+    if not isinstance(obstacle, Translatable):
+        return _Shifted(obstacle, origin)
+    local = copy.copy(obstacle)
+    setattr(local, local.anchor_name, getattr(obstacle, obstacle.anchor_name) - origin)
+    return local

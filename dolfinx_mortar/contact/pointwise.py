@@ -23,6 +23,7 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.cut_quadrature import positive_part_rule
+from dolfinx_mortar.contact.obstacles import relative_to
 from dolfinx_mortar.contact.penalty_law import positive_part
 from dolfinx_mortar.surfaces.lagrange import measure_from_tangents
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
@@ -50,24 +51,27 @@ def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: Fl
     """``d̄⁺`` at the local slave nodes and ``G⁺`` against a rigid obstacle.
 
     ``u_nodes``: displacement at the local slave-layout nodes, (nodes, gdim);
-    ``points``: the current quadrature points that ``model.evaluate`` returned.
+    ``points``: the current quadrature points that ``model.evaluate`` returned
+    (relative to ``model.origin``).
     """
     slave, tab = model.slave, model.tabulation
     cells, gdim = slave.cells, slave.gdim
     if model.reference is not None:
         u_nodes = u_nodes - model.reference
     nc, nq, nd = tab.phi.shape
-    x_nodes = slave.x + u_nodes                       # current nodal positions
+    # current nodal positions relative to the model's origin, as the points are
+    x_nodes = (slave.x - model.origin) + u_nodes
+    obstacle = relative_to(model.obstacle, model.origin)
     xq = points.reshape(nc, nq, gdim)
-    d = -model.obstacle.signed_distance(xq.reshape(-1, gdim)).reshape(nc, nq)
-    d_nodes = -model.obstacle.signed_distance(x_nodes[cells].reshape(-1, gdim)).reshape(nc, nd)
+    d = -obstacle.signed_distance(xq.reshape(-1, gdim)).reshape(nc, nq)
+    d_nodes = -obstacle.signed_distance(x_nodes[cells].reshape(-1, gdim)).reshape(nc, nd)
     samples = np.concatenate([d, d_nodes], axis=1)
     full = np.all(samples > 0, axis=1)
     mixed = np.flatnonzero(np.any(samples > 0, axis=1) & ~full)
 
     # fully penetrating cells: the Gauss rule, as for the nodal gaps
     f = np.flatnonzero(full)
-    nu = model.obstacle.gradient(xq[f].reshape(-1, gdim)).reshape(len(f), nq, gdim)
+    nu = obstacle.gradient(xq[f].reshape(-1, gdim)).reshape(len(f), nq, gdim)
     wd = tab.weights[f] * d[f]
     values = [np.einsum("cqa,cq->ca", model.Mbar[f], wd)]
     rows = [cells[f]]
@@ -79,26 +83,26 @@ def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: Fl
 
     def gap_at(c: npt.NDArray[np.int64], X: FloatArray) -> FloatArray:
         N, _ = reference.tabulate(X, transformed=False)
-        return -model.obstacle.signed_distance(np.einsum("nb,nbk->nk", N, x_nodes[cells[c]]))
+        return -obstacle.signed_distance(np.einsum("nb,nbk->nk", N, x_nodes[cells[c]]))
 
     degree = 2 * reference.degree + 2
     owner, X, w_ref, _ = positive_part_rule(reference.cell, mixed, gap_at, degree,
                                             subdivisions=CUT_SUBDIVISIONS)
     c = mixed[owner]
     N, dN = reference.tabulate(X, transformed=False)
-    coords = slave.x[cells[c]]
+    coords = slave.x[cells[c]] - model.origin       # as x_nodes (r unchanged)
     tangents = [np.einsum("nb,nbk->nk", dN[:, t, :], coords) for t in range(slave.tdim)]
     # the surface's own measure, as its tabulation's weights (2πr ds if axisymmetric)
     w = (w_ref * measure_from_tangents(tangents)
          * slave.radial_factor(np.einsum("nb,nbk->nk", N, coords)))
     x = np.einsum("nb,nbk->nk", N, x_nodes[cells[c]])
-    dq = -model.obstacle.signed_distance(x)
+    dq = -obstacle.signed_distance(x)
     # the rule covers {d > 0} up to the bisection tolerance: clip the rest
     dq = positive_part(dq)
     Mbar = np.einsum("nb,nba->na", N, model.coefficients_std[c])
     values.append(Mbar * (w * dq)[:, None])
     rows.append(cells[c])
-    blocks.append(-np.einsum("n,na,nk,nb->nabk", w, Mbar, model.obstacle.gradient(x), N))
+    blocks.append(-np.einsum("n,na,nk,nb->nabk", w, Mbar, obstacle.gradient(x), N))
 
     row_cells = np.concatenate(rows)
     gaps = slave.layout.sum_at_functions(row_cells, np.concatenate(values))
