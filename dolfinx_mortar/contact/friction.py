@@ -41,7 +41,6 @@ when a step has converged: a cut-back retries from the same history.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
 import numpy as np
@@ -50,154 +49,20 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.friction_law import SLIP, CoulombFriction, ReturnMapping
+from dolfinx_mortar.contact.friction_state import (  # noqa: F401 (names of this module)
+    AugmentedFriction, FrictionHistory, FrictionState, SlipOperator, check_friction_options,
+    lumped_slave_part, solve_components, stacked_identities, tangent_projectors)
 from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import DUAL_KINDS, is_global
-from dolfinx_mortar.layout import MassMatrixSolver, assemble_blocks
+from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.linalg.sparse_products import kron_identity, transpose_mat_mult
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 
 FloatArray = npt.NDArray[np.float64]
 DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
-
-
-def check_friction_options(options: ContactOptions) -> None:
-    """NotImplementedError naming a combination friction does not support, and why."""
-    if options.law.pointwise:
-        raise NotImplementedError("friction with active_set='pointwise': the Coulomb cone is "
-                                  "set by the nodal normal forces; use active_set='nodal'")
-
-
-@dataclass
-class FrictionHistory:
-    """What friction remembers of the last accepted step.
-
-    Attributes
-    ----------
-    forces
-        The tangential nodal forces ``f_T`` at the local slave-layout nodes, (nodes, gdim).
-    u
-        The displacement vector of that step.
-    u_nodes
-        The same at the local slave-layout nodes, (nodes, gdim).
-    obstacle_displacement
-        The rigid obstacle's translation then (None against an elastic master).
-    dissipation
-        The frictional dissipation since the start, summed over all ranks.
-    step_dissipation
-        That of the last accepted step.
-    version
-        Counts the accepted steps.
-    accepted
-        The friction state of the last accepted step (None before the first):
-        what a result at that displacement reports, since evaluated again there
-        with its own forces as history every slipping node would sit on the
-        cone and count as sticking.
-    """
-
-    forces: FloatArray
-    u: PETSc.Vec
-    u_nodes: FloatArray
-    obstacle_displacement: Optional[FloatArray]
-    dissipation: float = 0.0
-    step_dissipation: float = 0.0
-    version: int = 0
-    accepted: Optional["FrictionState"] = None
-
-
-@dataclass
-class FrictionState:
-    """Friction at one displacement (part of a
-    :class:`~dolfinx_mortar.contact.state.ContactState`).
-
-    Attributes
-    ----------
-    slip_increment
-        ``Δy_T`` per local node since the last accepted step, (nodes, gdim).
-    mapping
-        The return mapping's forces, derivatives and stick/slip states.
-    G_T
-        ``∂Δy_T/∂u`` (rows: node·gdim + i), Dirichlet columns dropped.
-    tangential_weights
-        ``ω_T = ε_T W^m`` per node.
-    projected_history
-        ``P_A f_T,A^n``: the last accepted forces in the present tangent planes.
-    residual
-        ``G_Tᵀ f_T``, friction's part of the contact residual.
-    """
-
-    slip_increment: FloatArray
-    mapping: ReturnMapping
-    G_T: PETSc.Mat
-    tangential_weights: FloatArray
-    projected_history: FloatArray
-    residual: Optional[PETSc.Vec] = None
-
-
-@dataclass
-class _SlipOperator:
-    """The linear map of a step: ``Δy_T = to_local(G_T Δu) − obstacle_weights Δc``;
-    with ``mass`` (GLS, GLS*) ``Δy_T = P L⁻¹(Ĝ_T Δu − (∫N) Δc)``, G_T then
-    the standard basis's unprojected ``Ĝ_T``."""
-
-    G_T: PETSc.Mat
-    projectors: FloatArray              # P_A, (nodes, gdim, gdim)
-    obstacle_weights: Optional[FloatArray]  # (∫ M̄_A) P_A for the obstacle's motion
-    weights: FloatArray                 # ω = ε W^m of the model it was made from
-    mass: Optional[MassMatrixSolver] = None  # L of the global kinds
-
-
-@dataclass
-class AugmentedFriction:
-    """Friction's blocks of the GLS kinds' augmented Newton system (rows and
-    columns node·gdim + i of the slave layout; see
-    :class:`~dolfinx_mortar.contact.augmented.AugmentedNewtonStep`): with
-    ``w = L⁻¹ Ĝ_T Δu`` and ``Δz_T = L⁻¹ Δf_T``, ``Δf_T = PCP w + PBωH Δy``."""
-
-    G_T: PETSc.Mat      #: Ĝ_T, Dirichlet columns dropped
-    PCP: PETSc.Mat      #: P C P per node
-    PB: PETSc.Mat       #: P c_TN ωH per node (columns: the nodes)
-    L: PETSc.Mat        #: L ⊗ I_gdim
-
-
-def _projectors(normals: FloatArray) -> FloatArray:
-    gdim = normals.shape[1]
-    return np.eye(gdim)[None] - normals[:, :, None] * normals[:, None, :]
-
-
-def _identities(projectors: FloatArray) -> FloatArray:
-    return np.broadcast_to(np.eye(projectors.shape[1]), projectors.shape)
-
-
-def _solve_components(mass: MassMatrixSolver, values: FloatArray) -> FloatArray:
-    """``L⁻¹`` applied to each component of nodal vectors (nodes, gdim)."""
-    return np.stack([mass.solve(values[:, i]) for i in range(values.shape[1])], axis=1)
-
-
-def _lumped_slave_part(blocks: FloatArray, slave_nodes: int) -> FloatArray:
-    """The scalar slip couplings ``[D̄ | −M̄]`` (cells, rows, columns) with the
-    slave part ``D̄`` lumped onto its diagonal (row sums ``∫ M̄_A`` kept).
-
-    For LmLS and LmLS* ``D̄_AB = ∫ M̄_A N_B`` couples each node to its
-    neighbours (a row-scaled consistent mass, 1/6 : 2/3 : 1/6 on a uniform
-    line), and with it the nodal Coulomb conditions are set on an average of
-    the neighbours' slips. Newton's stick/slip iteration then ran away: on a
-    block pushed sideways at 0.2 of its load (μ = 0.3, ε = 1e3 E/h) the slip
-    of the slipping zone reversed from one iteration to the next, hundreds of
-    stick bands deep, and it stalled at every increment (a first step from
-    rest is the same problem at any load). The dual kinds' D̄ is diagonal
-    already (biorthogonality) and they converged in 4–5 iterations; lumped,
-    LmLS(*) converge in the same (docs/FRICTION.md). The row sums keep the
-    slip objective for rigid translations, and the master part stays the
-    mortar integral.
-    """
-    slave, master = blocks[:, :, :slave_nodes], blocks[:, :, slave_nodes:]
-    diagonal = np.zeros_like(slave)
-    rows = np.arange(slave.shape[1])
-    diagonal[:, rows, rows] = slave.sum(axis=2)
-    return np.concatenate([diagonal, master], axis=2)
 
 
 class Friction:
@@ -231,7 +96,7 @@ class Friction:
         self.penalty = law.penalty(options.penalty)
         self.slave, self.obstacle = slave, obstacle
         #: LmLS, LmLS*: the slip of a node from its own displacement (see
-        #: :func:`_lumped_slave_part`)
+        #: :func:`lumped_slave_part`)
         self._lumped = options.kind not in DUAL_KINDS and not is_global(options.kind)
         self.comm: MPI.Comm = slave.layout.comm
         u.x.scatter_forward()
@@ -240,7 +105,7 @@ class Friction:
             nodal_displacement(slave, u),
             None if obstacle is None else np.array(obstacle.displacement, dtype=float))
         self._step_start_model = step_start_model
-        self._operator: Optional[_SlipOperator] = None
+        self._operator: Optional[SlipOperator] = None
         #: the stick/slip states and slip directions of the last Jacobian (the
         #: exact slip tangent once they repeat)
         self._jacobian_states: Optional[tuple[npt.NDArray[np.int8], FloatArray]] = None
@@ -248,7 +113,7 @@ class Friction:
         self._operator_for: tuple = (None, -2)
 
     # -- the slip operator of a step ---------------------------------------------------
-    def _slip_operator(self, model) -> _SlipOperator:
+    def _slip_operator(self, model) -> SlipOperator:
         """The slip operator of the present step: made again for a new model
         and, against an obstacle (whose tangent planes are those where the step
         starts), for every new step; on the current surface from the model
@@ -284,16 +149,16 @@ class Friction:
         return assemble_blocks(model.dofs, rows, model.dofs, cols,
                                values.reshape(nc, nr * gdim, cols.shape[1]))
 
-    def _mortar_operator(self, model: MortarGap, project: bool) -> _SlipOperator:
+    def _mortar_operator(self, model: MortarGap, project: bool) -> SlipOperator:
         cells, cols, blocks = model.pair_operators
         if self._lumped and project:
-            blocks = _lumped_slave_part(blocks, cells.shape[1])
-        projectors = _projectors(model.coupling.normals)
-        applied = projectors if project else _identities(projectors)
-        return _SlipOperator(self._assemble(model, cells, cols, blocks, applied),
+            blocks = lumped_slave_part(blocks, cells.shape[1])
+        projectors = tangent_projectors(model.coupling.normals)
+        applied = projectors if project else stacked_identities(projectors)
+        return SlipOperator(self._assemble(model, cells, cols, blocks, applied),
                              projectors, None, model.weights)
 
-    def _obstacle_operator(self, model: ObstacleGap, project: bool) -> _SlipOperator:
+    def _obstacle_operator(self, model: ObstacleGap, project: bool) -> SlipOperator:
         """Tangent planes of the obstacle below each node where the step starts
         (the obstacle translated back to where it was then)."""
         h = self.history
@@ -303,15 +168,15 @@ class Friction:
         back = np.asarray(self.obstacle.displacement) - h.obstacle_displacement
         normals = np.zeros_like(u_nodes)
         normals[nodes] = self.obstacle.gradient(model.slave.x[nodes] + u_nodes[nodes] + back)
-        projectors = _projectors(normals)
+        projectors = tangent_projectors(normals)
         blocks = np.einsum("cq,cqa,cqb->cab", tab.weights, model.Mbar, tab.phi)
         if self._lumped and project:
-            blocks = _lumped_slave_part(blocks, blocks.shape[2])
+            blocks = lumped_slave_part(blocks, blocks.shape[2])
         nc, nd = cells.shape
         cols = model.node_dofs(cells).reshape(nc, nd * self.slave.gdim)
         mass = self.slave.layout.sum_at_functions(cells, blocks.sum(axis=2))
-        applied = projectors if project else _identities(projectors)
-        return _SlipOperator(self._assemble(model, cells, cols, blocks, applied),
+        applied = projectors if project else stacked_identities(projectors)
+        return SlipOperator(self._assemble(model, cells, cols, blocks, applied),
                              projectors, mass[:, None, None] * applied, model.weights)
 
     # -- evaluation --------------------------------------------------------------------
@@ -334,7 +199,7 @@ class Friction:
             slip -= operator.obstacle_weights @ motion
         if operator.mass is not None:
             slip = np.einsum("aik,ak->ai", operator.projectors,
-                             _solve_components(operator.mass, slip))
+                             solve_components(operator.mass, slip))
         weights = operator.weights * (self.penalty / self.normal_law.penalty)
         history = np.einsum("aik,ak->ai", operator.projectors, h.forces)
         trial = history + weights[:, None] * slip
@@ -348,7 +213,7 @@ class Friction:
         force = mapping.force
         if operator.mass is not None:
             # R_T = Ĝ_Tᵀ L⁻¹ P f_T, with P f_T = f_T
-            force = _solve_components(operator.mass, force)
+            force = solve_components(operator.mass, force)
         f.array[:] = force[: self.slave.layout.num_owned].ravel()
         residual = G_T.createVecRight()
         G_T.multTranspose(f, residual)
