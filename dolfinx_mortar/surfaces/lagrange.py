@@ -358,8 +358,7 @@ class LagrangeSurface:
         N, dN = self.reference.tabulate(X, transformed=transformed)
         N_geo, _ = self.reference.tabulate(X, transformed=False)
         coords = self.x[self.cells]  # (nc, nd, gdim)
-        # relative to each cell's first node, so that the tangents' round-off is that of
-        # the cell's size, not of |x| (a facet at 1e8 had |J| off by 1e-5)
+        # relative to each cell's first node: round-off of its size, not |x| (|J| at 1e8: 1e-5)
         origin = coords[:, :1, :]
         coords = coords - origin
         # matmul broadcasts over cells and is several times faster than einsum here
