@@ -19,6 +19,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
@@ -41,20 +42,24 @@ def tagged_rectangle(comm, y0: float, y1: float, n: tuple[int, int], tags: dict)
         f = mesh.locate_entities_boundary(domain, 1, where[side])
         facets.append(f)
         values.append([tag] * len(f))
-    import numpy as np
     facets, values = np.concatenate(facets), np.concatenate(values).astype(np.int32)
     order = np.argsort(facets)
     return domain, mesh.meshtags(domain, 1, facets[order], values[order])
 
 
 def approach(kind: str, configuration: str, gap: float, master: str,
-             comm=MPI.COMM_WORLD) -> ContactProblem:
+             comm=MPI.COMM_WORLD, dim: int = 2, **options) -> ContactProblem:
     """The block [0,1]×[0,½] (8×4) ``gap`` element lengths above a rigid plane
     (``master="rigid"``) or above an elastic block [0,1]×[−½,−gap·h] (7×4,
     fixed at its bottom), its top face pushed down by gap·h + DEPTH, its left
-    side fixed sideways."""
+    side fixed sideways. ``dim=3``: the box [0,1]²×[0,½] (8×8×4) on the plane,
+    fixed sideways on x = 0 and y = 0. ``options`` go to the problem
+    (``active_set``, ``axisymmetric``, ...)."""
+    options = dict(E=1.0, nu=0.3, kind=kind, penalty=1e3 / H, basis_configuration=configuration,
+                   **options)
+    if dim == 3:
+        return _box_on_plane(comm, gap, options)
     push = {TOP: {1: -(gap * H + DEPTH)}, LEFT: {0: 0.0}}
-    options = dict(E=1.0, nu=0.3, kind=kind, penalty=1e3 / H, basis_configuration=configuration)
     slave_mesh, slave_tags = tagged_rectangle(comm, 0.0, 0.5, (8, 4),
                                               {"bottom": SLAVE, "top": TOP, "left": LEFT})
     if master == "rigid":
@@ -66,6 +71,25 @@ def approach(kind: str, configuration: str, gap: float, master: str,
     return ContactProblem.from_two_meshes(slave_mesh, slave_tags, SLAVE, master_mesh, master_tags,
                                           MASTER, fixed={**push, BASE: {0: 0.0, 1: 0.0}},
                                           **options)
+
+
+def _box_on_plane(comm, gap: float, options: dict) -> ContactProblem:
+    domain = mesh.create_box(comm, [[0, 0, 0], [1, 1, 0.5]], [8, 8, 4])
+    sides = [(SLAVE, 2, 0.0), (TOP, 2, 0.5), (LEFT, 0, 0.0), (BASE, 1, 0.0)]
+    facets, values = [], []
+    for tag, axis, level in sides:
+        f = mesh.locate_entities_boundary(domain, 2, lambda x, a=axis, v=level:
+                                          np.abs(x[a] - v) < 1e-12)
+        facets.append(f)
+        values.append(np.full(len(f), tag, dtype=np.int32))
+    facets, values = np.concatenate(facets), np.concatenate(values)
+    # a boundary facet lies on one side of the box only
+    order = np.argsort(facets)
+    tags = mesh.meshtags(domain, 2, facets[order], values[order])
+    V = fem.functionspace(domain, ("Lagrange", 1, (3,)))
+    fixed = {TOP: {2: -(gap * H + DEPTH)}, LEFT: {0: 0.0}, BASE: {1: 0.0}}
+    return ContactProblem(V, tags, SLAVE, obstacle=RigidPlane([0, 0, -gap * H], [0, 0, 1]),
+                          fixed=fixed, **options)
 
 
 def run(kind: str, configuration: str, gap: float, master: str, steps: int) -> dict:

@@ -57,6 +57,24 @@ def test_a_body_approaching_from_a_gap_ends_with_the_one_step_force(kind, config
         assert abs(many - one) <= abs(current - one) + 1e-4 * one, (gap, steps, one, current)
 
 
+@pytest.mark.parametrize("configuration", ["initial", "current"])
+@pytest.mark.parametrize("variant, kind, options", [
+    ("pointwise", "LmLS*", dict(active_set="pointwise")),
+    ("axisymmetric", "LmLS*", dict(axisymmetric=True)),
+    ("3D", "LcLS*", dict(dim=3))])
+def test_the_documented_options_approach_from_a_gap_too(variant, kind, options, configuration):
+    """The pointwise active set, an (r, z) body and a 3D box, 10 steps from 0.2 h:
+    the one-step force to round-off."""
+    forces = [final_force_of(grid.approach(kind, configuration, 0.2, "rigid", **options), steps)
+              for steps in (1, 10)]
+    assert forces[1] == pytest.approx(forces[0], rel=1e-9)
+
+
+def final_force_of(problem: ContactProblem, steps: int) -> float:
+    problem.solve(load_steps=steps)
+    return problem.normal_force()
+
+
 def test_the_quickstart_disk_lowered_by_a_fifth_of_an_element_in_the_current_configuration():
     """The quickstart's scene with the disk h/5 below the block, 10 steps, on the
     current surface: 1,114 failed attempts in 100 s without an exception before."""
