@@ -47,6 +47,8 @@ class InitialConfiguration:
     """
 
     name = "initial"
+    #: whether the bases are built where u has moved the surfaces (not in the reference)
+    built_at_u = False
     #: the bases follow u at every evaluation (a step is solved in two phases)
     follows_u = False
     #: the pairs are found once, where the term is made
@@ -110,6 +112,7 @@ class PreviousConfiguration(InitialConfiguration):
     step: rebuilt when a load step starts if u moved since."""
 
     name = "previous"
+    built_at_u = True
     pairs_found_once = False
     pattern_grows = True
 
@@ -133,6 +136,7 @@ class CurrentConfiguration(InitialConfiguration):
     """
 
     name = "current"
+    built_at_u = True
     follows_u = True
     pairs_found_once = False
     pattern_grows = True

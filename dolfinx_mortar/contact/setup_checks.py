@@ -64,7 +64,7 @@ def check_initial_overlap(term, coupling) -> None:
     comm = term.mesh.comm
     if term.master is None or coupling is None or comm.allreduce(len(coupling.pairs)) > 0:
         return
-    moved = term.basis_configuration != "initial"
+    moved = term.configuration.built_at_u
     displacements = ([nodal_displacement(surface, term.u) for surface in (term.slave, term.master)]
                      if moved else [None, None])
     for factor in OVERLAP_SEARCH_FACTORS:
