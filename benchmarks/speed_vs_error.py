@@ -67,7 +67,7 @@ COLUMNS = ("scene", "obstacle", "refine", "dofs", "slave_nodes", "kind", "penalt
 
 def setup_times(problem) -> dict:
     """Contact setup phases of a freshly built problem (seconds, this rank)."""
-    from dolfinx_mortar.contact.global_gap import GlobalGap
+    from dolfinx_mortar.contact.gap_sources.global_gap import GlobalGap
     model = problem.gap_model
     inner = model.inner if isinstance(model, GlobalGap) else model
     basis = inner.basis.construction_time

@@ -61,7 +61,7 @@ _LAZY = {
     "RigidCylinder": "dolfinx_mortar.contact.obstacles",
     "SurfacePressure": "dolfinx_mortar.contact.results",
     "SurfaceFriction": "dolfinx_mortar.contact.results",
-    "CoulombFriction": "dolfinx_mortar.contact.friction_law",
+    "CoulombFriction": "dolfinx_mortar.contact.laws",
 }
 
 __all__ = ["basis", "kinds", "lagrange", "nurbs", "MortarBasis", "KIND_NAMES",

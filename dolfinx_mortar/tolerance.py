@@ -30,6 +30,11 @@ GEOMETRIC_TOLERANCE: float = _kernels.geometric_tolerance
 NEGLIGIBLE_FACET_RATIO: float = _kernels.negligible_facet_ratio
 
 
+#: nodes within this fraction of their element length of contact are near contact (they
+#: stiffen when nothing touches yet, and the current surface keeps their pairs)
+NEAR_CONTACT = 0.1
+
+
 def length_scale(x: npt.ArrayLike, comm: Optional[MPI.Comm] = None) -> float:
     """Bounding-box diagonal of points ``x`` (their extent; 0 for one point).
 

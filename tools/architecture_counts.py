@@ -24,12 +24,12 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "dolfinx_mortar"
 KERNELS = ROOT / "kernels"
 #: modules allowed to ask which configuration or Newton entry a term has
-OWNERS = {"contact/configuration.py", "contact/newton_entry.py", "contact/options.py"}
+OWNERS = {"contact/gap_sources/configuration.py", "contact/newton/entry.py", "contact/options.py"}
 #: the penalty law's own module
-LAW = "contact/penalty_law.py"
+LAW = "contact/laws/penalty.py"
 #: the current configuration's Python
-CURRENT = ("contact/finite_deformation.py", "contact/current_obstacle.py",
-           "contact/current_mortar.py")
+CURRENT = ("contact/gap_sources/current/finite_deformation.py", "contact/gap_sources/current/obstacle.py",
+           "contact/gap_sources/current/mortar.py")
 #: keys of the dictionaries the kernels' bindings return
 KERNEL_KEYS = ("value", "gradient", "hessian", "nodes", "value_plus", "gradient_plus", "gap",
                "normals", "weights", "pairs", "slave_N", "master_N", "D", "M", "g")

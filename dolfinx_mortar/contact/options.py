@@ -7,7 +7,7 @@ from typing import Optional
 
 import numpy as np
 
-from dolfinx_mortar.contact.penalty_law import PenaltyLaw
+from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, parse_kind
 
 CONFIGURATIONS = ("initial", "previous", "current")
@@ -24,10 +24,10 @@ class ContactOptions:
         The mortar basis kind.
     law
         The penalty law: penalty, scaling and active set
-        (:class:`~dolfinx_mortar.contact.penalty_law.PenaltyLaw`).
+        (:class:`~dolfinx_mortar.contact.laws.penalty.PenaltyLaw`).
     basis_configuration
         ``"initial"``, ``"previous"`` or ``"current"``
-        (:mod:`~dolfinx_mortar.contact.configuration`).
+        (:mod:`~dolfinx_mortar.contact.gap_sources.configuration`).
     boundary_modification
         The dual basis rebuilt over the covered part of partly covered facets.
     search_radius

@@ -28,22 +28,22 @@ from dolfinx import fem
 from dolfinx.fem import petsc as fem_petsc
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.active_set import NearContactStiffness, gap_closing_force
+from dolfinx_mortar.contact.newton import NearContactStiffness, gap_closing_force
 from dolfinx_mortar.contact.checks import RangeChecks
-from dolfinx_mortar.contact.configuration import configuration_of
+from dolfinx_mortar.contact.gap_sources import configuration_of
 from dolfinx_mortar.contact.friction import Friction
-from dolfinx_mortar.contact.friction_law import CoulombFriction
-from dolfinx_mortar.contact.newton_entry import entry_of
+from dolfinx_mortar.contact.laws import CoulombFriction
+from dolfinx_mortar.contact.newton import entry_of
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.results import ContactResults
-from dolfinx_mortar.contact.state import ContactState, GapModel
+from dolfinx_mortar.contact.gap_sources import ContactState, GapSource
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.io.contact_output import check_term_name
 from dolfinx_mortar.kinds import KindLike
-from dolfinx_mortar.contact.setup_checks import (check_initial_overlap,
-                                                 check_penalty_represents_a_force,
-                                                 warn_if_the_obstacle_faces_away)
+from dolfinx_mortar.contact.checks import (check_initial_overlap,
+                                           check_penalty_represents_a_force,
+                                           warn_if_the_obstacle_faces_away)
 from dolfinx_mortar.input_checks import (check_cells, check_contact_arguments,
                                          check_contact_tags, collective_checks,
                                          communicator_of)
@@ -68,7 +68,7 @@ class ContactTerm:
         Tag of the master facets in the same mesh (two bodies), or None.
     obstacle
         A rigid analytic obstacle instead of a master surface
-        (:mod:`dolfinx_mortar.contact.obstacles`); it may be moved between
+        (:mod:`dolfinx_mortar.contact.obstacles.analytic`); it may be moved between
         load steps (``obstacle.move_to``).
     kind
         Mortar basis kind, any of the six (docs/DESIGN.md, §Bases).
@@ -106,7 +106,7 @@ class ContactTerm:
         must be axisymmetric too
         (:func:`~dolfinx_mortar.small_strain.elastic.axisymmetric_elastic_residual`).
     friction
-        Coulomb friction (:class:`~dolfinx_mortar.contact.friction_law.CoulombFriction`:
+        Coulomb friction (:class:`~dolfinx_mortar.contact.laws.coulomb.CoulombFriction`:
         μ and the tangential penalty), or None (frictionless, default). Its
         history moves on in :meth:`accept_step` (docs/FRICTION.md).
     name
@@ -173,7 +173,7 @@ class ContactTerm:
                 def step_start(u_nodes, u_vector):
                     return self.configuration.frozen_model_at(self.options, u_nodes, u_vector)
             self.friction = Friction(friction, options, u, self.slave, obstacle, step_start)
-        self.model: GapModel = self._timed_build(self.configuration.build, options)
+        self.model: GapSource = self._timed_build(self.configuration.build, options)
         self.checks.warn_deep_initial_penetration()
         if obstacle is not None:
             warn_if_the_obstacle_faces_away(obstacle, self.slave, mesh.comm)
@@ -187,7 +187,7 @@ class ContactTerm:
         """``"initial"``, ``"previous"`` or ``"current"``."""
         return self.configuration.name
 
-    def _timed_build(self, build, options: ContactOptions) -> Optional[GapModel]:
+    def _timed_build(self, build, options: ContactOptions) -> Optional[GapSource]:
         """``build(options, u)``; where it makes a new model (not None), the
         state of the old one is dropped."""
         clock = time.perf_counter()
@@ -217,7 +217,7 @@ class ContactTerm:
         """The bases and segmentation made again with another search radius, in
         the configuration they were built in (a widened default radius:
         :meth:`RangeChecks.widen_search_radius
-        <dolfinx_mortar.contact.checks.RangeChecks.widen_search_radius>`)."""
+        <dolfinx_mortar.contact.checks.range_checks.RangeChecks.widen_search_radius>`)."""
         self.options = replace(self.options, search_radius=search_radius)
         self.model = self._timed_build(self.configuration.rebuild, self.options)
 
@@ -359,7 +359,7 @@ class ContactTerm:
     def active_nodes_mask(self, state: ContactState) -> FloatArray:
         """Nodes that get contact stiffness (H(d̄) as 0/1, and the nodes near
         contact where the bulk cannot hold the body:
-        :class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`)."""
+        :class:`~dolfinx_mortar.contact.newton.near_contact.NearContactStiffness`)."""
         return self._near_contact.mask(self.model, state)
 
     def settle_near_contact(self, free_motions) -> None:
@@ -368,21 +368,21 @@ class ContactTerm:
         whether those nodes need stiffness without force: only if one of the
         bodies' ``free_motions`` (a callable giving the rigid motions that
         the bulk does not resist, as dof vectors) changes their gaps
-        (:class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`;
+        (:class:`~dolfinx_mortar.contact.newton.near_contact.NearContactStiffness`;
         collective)."""
         if self.state is not None and self._near_contact.due(self.model, self.state):
             self._near_contact.decide(self.model, self.state, free_motions())
 
     def gap_closing_force(self) -> Optional[PETSc.Vec]:
         """The pull that closes the gaps near contact when nothing touches yet
-        (:func:`~dolfinx_mortar.contact.active_set.gap_closing_force`)."""
+        (:func:`~dolfinx_mortar.contact.newton.near_contact.gap_closing_force`)."""
         return gap_closing_force(self.model, self.state)
 
     @contextmanager
     def closing_gaps(self) -> Iterator[None]:
         """Inside the block the Jacobian stiffens the nodes near contact
         whatever holds the body: the gap-closing start's linear model
-        (:class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`)."""
+        (:class:`~dolfinx_mortar.contact.newton.near_contact.NearContactStiffness`)."""
         self._near_contact.closing = True
         try:
             yield

@@ -178,7 +178,7 @@ def free_rigid_motions(A: PETSc.Mat, modes: list[PETSc.Vec],
     entries) is a unit row, and counts what ``r`` moves at its dof at A's
     scale; a spring in the user's form counts as it stiffens. The modes must
     be orthonormal (:func:`rigid_body_modes`). Used to decide whether only
-    the contact can hold a body (:class:`~dolfinx_mortar.contact.active_set.NearContactStiffness`).
+    the contact can hold a body (:class:`~dolfinx_mortar.contact.newton.near_contact.NearContactStiffness`).
     Collective.
     """
     scale = A.norm(PETSc.NormType.NORM_INFINITY)

@@ -19,10 +19,10 @@ import ufl
 from dolfinx import fem
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.friction_law import CoulombFriction
+from dolfinx_mortar.contact.laws import CoulombFriction
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.term import ContactTerm
-from dolfinx_mortar.contact.setup_checks import check_penalty_against_stiffness
+from dolfinx_mortar.contact.checks import check_penalty_against_stiffness
 from dolfinx_mortar.input_checks import (check_boundary_data, check_tags, collective_checks,
                                          communicator_of)
 from dolfinx_mortar.kinds import KindLike
@@ -147,7 +147,7 @@ class ContactProblem:
 
     @property
     def gap_model(self):
-        """The contact term's gap model (:class:`~dolfinx_mortar.contact.state.GapModel`)."""
+        """The contact term's gap model (:class:`~dolfinx_mortar.contact.gap_sources.source.GapSource`)."""
         return self.contact.model
 
     @property
@@ -197,7 +197,7 @@ class ContactProblem:
 
     def surface_pressure(self, state=None, gather: bool = False):
         """The contact pressure at the slave nodes with their coordinates
-        (:meth:`~dolfinx_mortar.contact.results.ContactResults.surface_pressure`)."""
+        (:meth:`~dolfinx_mortar.contact.results.contact_results.ContactResults.surface_pressure`)."""
         return self.contact.results.surface_pressure(state, gather)
 
     def mortar_traction(self, state=None):

@@ -52,7 +52,7 @@ class StepResult:
     #: per contact term with friction (None without): the tangential force
     #: resultant on the slave body, the step's and the total frictional
     #: dissipation, and the numbers of sticking and slipping nodes
-    #: (:meth:`~dolfinx_mortar.contact.results.ContactResults.friction_summary`)
+    #: (:meth:`~dolfinx_mortar.contact.results.contact_results.ContactResults.friction_summary`)
     friction: list = field(default_factory=list)
 
     def terminal_iterations(self, near: float = 1e-3) -> int:

@@ -1,5 +1,5 @@
 """Which nodes stiffen while nothing penetrates yet, decided the same way on every
-partition (dolfinx_mortar.contact.active_set)."""
+partition (dolfinx_mortar.contact.newton.near_contact)."""
 from __future__ import annotations
 
 from types import SimpleNamespace
@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from dolfinx_mortar.contact.active_set import penetrates, stiffened_nodes
+from dolfinx_mortar.contact.newton import penetrates, stiffened_nodes
 from dolfinx_mortar.layout import NodeLayout
 from dolfinx_mortar.tolerance import length_scale, zero_length
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dolfinx_mortar.contact.friction_law import SLIP, STICK, SEPARATED, CoulombFriction
+from dolfinx_mortar.contact.laws import SLIP, STICK, SEPARATED, CoulombFriction
 
 RNG = np.random.default_rng(7)
 

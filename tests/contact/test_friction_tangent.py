@@ -11,7 +11,7 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactProblem, CoulombFriction, RigidPlane, RigidSphere
-from dolfinx_mortar.contact.friction_law import SLIP, STICK
+from dolfinx_mortar.contact.laws import SLIP, STICK
 from support import load_demo
 from support.jacobian_check import jacobian_error, newton_step_error
 from support.scenes import LOCAL_KINDS, block_on_plane

@@ -11,7 +11,7 @@ from mpi4py import MPI
 from dolfinx_mortar import ContactProblem, RigidPlane
 from support.scenes import block_on_plane
 
-CHECKS = "dolfinx_mortar.contact.checks"
+CHECKS = "dolfinx_mortar.contact.checks.range_checks"
 
 
 def pressed(traction: float) -> ContactProblem:

@@ -6,7 +6,7 @@ import pytest
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from dolfinx_mortar.contact.cut_quadrature import positive_part_rule
+from dolfinx_mortar.contact.gap_sources.cut_quadrature import positive_part_rule
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactDivergenceError, ContactProblem
 from support.jacobian_check import jacobian_error

@@ -1,9 +1,9 @@
-"""What every gap model returns: the contact state at one displacement.
+"""The gap-source interface, and what every gap source returns: the contact state at one displacement.
 
 All gap models — rigid obstacle, elastic master, GLS/GLS*, pointwise active
 set, current configuration — answer the same three questions
-(:class:`GapModel`): the state at a displacement (:meth:`GapModel.evaluate`),
-the contact stiffness at that state (:meth:`GapModel.jacobian`), and the
+(:class:`GapSource`): the state at a displacement (:meth:`GapSource.evaluate`),
+the contact stiffness at that state (:meth:`GapSource.jacobian`), and the
 pressures and traction it carries. The contact term
 (:class:`~dolfinx_mortar.contact.term.ContactTerm`) only talks to this
 interface.
@@ -53,15 +53,15 @@ class ContactState:
     covered: Optional[npt.NDArray[np.bool_]] = None
     coefficients: Optional[FloatArray] = None
     #: friction at this displacement (a
-    #: :class:`~dolfinx_mortar.contact.friction.FrictionState`; None: frictionless)
+    #: :class:`~dolfinx_mortar.contact.friction.tangential.FrictionState`; None: frictionless)
     friction: Any = None
 
 
-class GapModel(Protocol):
-    """The one interface of the gap models (:mod:`~dolfinx_mortar.contact.gaps`,
-    :mod:`~dolfinx_mortar.contact.global_gap`,
-    :mod:`~dolfinx_mortar.contact.finite_deformation`,
-    :mod:`~dolfinx_mortar.contact.current_mortar`)."""
+class GapSource(Protocol):
+    """The one interface of the gap models (:mod:`~dolfinx_mortar.contact.gap_sources.frozen`,
+    :mod:`~dolfinx_mortar.contact.gap_sources.global_gap`,
+    :mod:`~dolfinx_mortar.contact.gap_sources.current.finite_deformation`,
+    :mod:`~dolfinx_mortar.contact.gap_sources.current.mortar`)."""
 
     #: the pairs, and so the matrix pattern, change inside a Newton solve
     moving_pattern: bool

@@ -17,8 +17,8 @@ exact for the nodal active set (semi-smooth Newton). The scalings:
 Two gap models with bases frozen in one configuration: :class:`ObstacleGap`
 (rigid analytic obstacle, exact and nonlinear in u) and :class:`MortarGap`
 (elastic master, segmented once, linear in u). Both implement
-:class:`~dolfinx_mortar.contact.state.GapModel`; so do
-:class:`~dolfinx_mortar.contact.global_gap.GlobalGap` (GLS kinds) and the
+:class:`~dolfinx_mortar.contact.gap_sources.source.GapSource`; so do
+:class:`~dolfinx_mortar.contact.gap_sources.global_gap.GlobalGap` (GLS kinds) and the
 current-configuration models.
 """
 from __future__ import annotations
@@ -31,13 +31,13 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.bases.basis import MortarBasis
-from dolfinx_mortar.contact.state import ContactState
-from dolfinx_mortar.contact.penalty_law import PenaltyLaw
+from dolfinx_mortar.contact.gap_sources.source import ContactState
+from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle, relative_to
-from dolfinx_mortar.contact.pointwise import MortarPointGaps, obstacle_positive_gaps
+from dolfinx_mortar.contact.gap_sources.pointwise import MortarPointGaps, obstacle_positive_gaps
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.linalg.sparse_products import TransposeProduct, transpose_mat_mult
 from dolfinx_mortar.tolerance import local_origin
@@ -51,10 +51,10 @@ def dof_layout(nodes: NodeLayout, bs: int) -> NodeLayout:
     return NodeLayout(nodes.comm, nodes.num_owned * bs, ghosts)
 
 
-class GapModelBase:
+class GapSourceBase:
     """Shared state: the slave surface, the gap basis and the node weights ω,
     and what the models with frozen bases share of
-    :class:`~dolfinx_mortar.contact.state.GapModel`."""
+    :class:`~dolfinx_mortar.contact.gap_sources.source.GapSource`."""
 
     moving_pattern = False
     #: the segmentation against an elastic master (None against an obstacle)
@@ -84,7 +84,7 @@ class GapModelBase:
     def nodal_pressures(self, state: ContactState) -> FloatArray:
         """``p_A = ε⟨d̄_A⟩`` (nodal active set) or ``ε d̄⁺_A`` (pointwise),
         consistent scaling (:meth:`PenaltyLaw.pressure
-        <dolfinx_mortar.contact.penalty_law.PenaltyLaw.pressure>`)."""
+        <dolfinx_mortar.contact.laws.penalty.PenaltyLaw.pressure>`)."""
         return self.law.pressure(state.weights, state.lumped_weights, state.gaps,
                                  state.gaps_plus)
 
@@ -161,7 +161,7 @@ class GapModelBase:
         return g[..., None] * bs + np.arange(bs)
 
 
-class ObstacleGap(GapModelBase):
+class ObstacleGap(GapSourceBase):
     """Nodal gaps against a rigid analytic obstacle: ``d = −φ(x + u)``.
 
     Exact in u (no segmentation: the obstacle lies below every slave point).
@@ -255,7 +255,7 @@ class ObstacleGap(GapModelBase):
         return blocks.reshape(nc, nd * gdim, nd * gdim)
 
 
-class MortarGap(GapModelBase):
+class MortarGap(GapSourceBase):
     """Nodal gaps against an elastic master in the same mesh, small deformation.
 
     Segmented once, in the configuration of ``reference`` (the displacement

@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.contact.checks import DEEP_PENETRATION
+from dolfinx_mortar.contact.checks.range_checks import DEEP_PENETRATION
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.tolerance import length_scale, zero_length
@@ -23,7 +23,7 @@ def warn_if_the_obstacle_faces_away(obstacle, slave, comm: MPI.Comm) -> None:
     the slave body (a RigidPlane with its normal flipped), and nothing can
     ever touch. It was reported as Newton "stalled" with nothing in reach
     (collective). A warning, as for a master facing away
-    (:meth:`~dolfinx_mortar.contact.checks.RangeChecks.warn_if_no_master_is_in_reach`).
+    (:meth:`~dolfinx_mortar.contact.checks.range_checks.RangeChecks.warn_if_no_master_is_in_reach`).
     """
     facing = False
     if len(slave.cells):
@@ -53,7 +53,7 @@ def check_initial_overlap(term, coupling) -> None:
     the surfaces are searched again with wider radii
     (:data:`OVERLAP_SEARCH_FACTORS`); where a slave node lies behind the master
     surface by more than DEEP_PENETRATION slave element lengths
-    (:mod:`~dolfinx_mortar.contact.checks`), the bodies overlap. Two blocks
+    (:mod:`~dolfinx_mortar.contact.checks.range_checks`), the bodies overlap. Two blocks
     overlapping by two elements were reported as out of reach (collective).
 
     Raises

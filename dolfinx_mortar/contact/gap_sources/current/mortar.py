@@ -25,9 +25,9 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.contact.active_set import NEAR_CONTACT
-from dolfinx_mortar.contact.finite_deformation import CurrentSurfaceGap, SourceGaps
-from dolfinx_mortar.contact.penalty_law import PenaltyLaw, safe_weights
+from dolfinx_mortar.tolerance import NEAR_CONTACT
+from dolfinx_mortar.contact.gap_sources.current.finite_deformation import CurrentSurfaceGap, SourceGaps
+from dolfinx_mortar.contact.laws import PenaltyLaw, safe_weights
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
 from dolfinx_mortar.mortar.coupling import (MortarCoupling, gather_surface, polynomial_degree,
@@ -79,7 +79,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
     slave, master
         The surfaces in the reference configuration (one displacement space).
     kind, law
-        As for :class:`~dolfinx_mortar.contact.finite_deformation.CurrentSurfaceGap`
+        As for :class:`~dolfinx_mortar.contact.gap_sources.current.finite_deformation.CurrentSurfaceGap`
         (pointwise: ⟨d⟩ at the segment quadrature points, as with frozen bases).
     search_radius
         As for :class:`~dolfinx_mortar.mortar.coupling.MortarCoupling` (pairs are found
@@ -225,7 +225,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
 
     def near_contact(self, g: FloatArray, W: FloatArray) -> npt.NDArray[np.bool_]:
         """Nodes whose gap derivatives are needed: those that may get contact
-        force or stiffness (:func:`~dolfinx_mortar.contact.active_set.stiffened_nodes`:
+        force or stiffness (:func:`~dolfinx_mortar.contact.newton.near_contact.stiffened_nodes`:
         y ≥ −NEAR_CONTACT·length), with a margin of 2 for the change of W
         between the reference and the current surface. The others' rows of
         ∂ĝ/∂u may be incomplete: they are multiplied by zero in the residual

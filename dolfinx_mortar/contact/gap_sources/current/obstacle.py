@@ -3,7 +3,7 @@
 ``d = −φ(x + u)`` with φ the obstacle's exact signed distance: the obstacle
 gives d and its first and second derivatives at the cells' current
 quadrature points, and the kernel's Jets carry them through the area element
-into ``ĝ_A = ∫ φ_A J d`` (:mod:`~dolfinx_mortar.contact.finite_deformation`).
+into ``ĝ_A = ∫ φ_A J d`` (:mod:`~dolfinx_mortar.contact.gap_sources.current.finite_deformation`).
 """
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.contact.finite_deformation import (CurrentSurfaceGap, ObstaclePoints,
+from dolfinx_mortar.contact.gap_sources.current.finite_deformation import (CurrentSurfaceGap, ObstaclePoints,
                                                        SourceGaps)
 from dolfinx_mortar.contact.obstacles import RigidObstacle, relative_to
-from dolfinx_mortar.contact.penalty_law import PenaltyLaw
+from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface

@@ -1,10 +1,10 @@
 """Coulomb's friction law with a tangential penalty: the return mapping.
 
-Beside the normal law (:mod:`~dolfinx_mortar.contact.penalty_law`), which
+Beside the normal law (:mod:`~dolfinx_mortar.contact.laws.penalty`), which
 gives each slave node A its normal force ``f_N,A = ω_A⟨y_A⟩``, friction gives
 it a tangential force ``f_T,A`` (a gdim-vector in the node's tangent plane)
 from the mortar-weighted tangential slip increment ``Δy_T,A`` of a load step
-(:mod:`~dolfinx_mortar.contact.friction`):
+(:mod:`~dolfinx_mortar.contact.friction.tangential`):
 
 - trial (elastic predictor): ``f* = P_A f_T,A^n + ω_T,A Δy_T,A`` with
   ``ω_T = ε_T W^m`` (the normal weights with ε_T for ε) and ``f_T^n`` the
@@ -151,6 +151,6 @@ class ReturnMapping:
     def secant_tangent(self) -> FloatArray:
         """``∂f_T/∂Δy_T`` with the slip branch's secant ``μ f_N ω_T/|f*|`` along
         t in place of its exact 0: what Newton uses while nodes still change
-        between stick and slip (:meth:`~dolfinx_mortar.contact.friction.Friction.jacobian`)."""
+        between stick and slip (:meth:`~dolfinx_mortar.contact.friction.tangential.Friction.jacobian`)."""
         t = self.direction
         return self.tangent + self.slip_stiffness[:, None, None] * t[:, :, None] * t[:, None, :]

@@ -12,7 +12,7 @@ configuration's name:
   with the exact Jacobian; a load step is solved first on the surface frozen
   where it starts (the "previous" model), then on the current one.
 
-A configuration builds the gap model (:mod:`~dolfinx_mortar.contact.models`
+A configuration builds the gap model (:mod:`~dolfinx_mortar.contact.gap_sources.choice`
 chooses the gap source), says what happens when a step starts, and how the
 contact stiffness enters the Newton matrix.
 """
@@ -25,12 +25,12 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.models import (current_model, frozen_model, moved,
+from dolfinx_mortar.contact.gap_sources.choice import (current_model, frozen_model, moved,
                                            refuse_false_penetration)
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.linalg.sparse_products import PatternTrackingAdd
-from dolfinx_mortar.contact.state import GapModel
+from dolfinx_mortar.contact.gap_sources.source import GapSource
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
@@ -64,26 +64,26 @@ class InitialConfiguration:
         self.built_at: Optional[FloatArray] = None
         self.built_vector: Optional[PETSc.Vec] = None
 
-    def build(self, options: ContactOptions, u) -> GapModel:
+    def build(self, options: ContactOptions, u) -> GapSource:
         """The gap model where the term is made (u: the displacement Function)."""
         return self.rebuild(options, u)
 
-    def rebuild(self, options: ContactOptions, u) -> GapModel:
+    def rebuild(self, options: ContactOptions, u) -> GapSource:
         """The model again with new options (a widened search radius), in the
         configuration the bases were built in."""
         return frozen_model(options, self.slave, self.master, self.obstacle, self.built_at,
                             self.built_vector)
 
-    def begin_step(self, options: ContactOptions, u) -> Optional[GapModel]:
+    def begin_step(self, options: ContactOptions, u) -> Optional[GapSource]:
         """A new model when a load step starts, or None to keep the present one."""
         return None
 
-    def frozen_model(self, options: ContactOptions, u) -> Optional[GapModel]:
+    def frozen_model(self, options: ContactOptions, u) -> Optional[GapSource]:
         """The model frozen at the present u for a step's first phase (None:
         the present model is frozen already)."""
         return None
 
-    def segmentation(self, model: GapModel) -> Optional[MortarCoupling]:
+    def segmentation(self, model: GapSource) -> Optional[MortarCoupling]:
         """A segmentation of this configuration already made, for the term's
         checks (None against an obstacle)."""
         return model.coupling
@@ -116,7 +116,7 @@ class PreviousConfiguration(InitialConfiguration):
     pairs_found_once = False
     pattern_grows = True
 
-    def begin_step(self, options: ContactOptions, u) -> Optional[GapModel]:
+    def begin_step(self, options: ContactOptions, u) -> Optional[GapSource]:
         u_nodes = nodal_displacement(self.slave, u)
         if not moved(u_nodes, self.built_at, self.slave.layout.comm):
             return None
@@ -149,27 +149,27 @@ class CurrentConfiguration(InitialConfiguration):
         self._add = PatternTrackingAdd()
         self._checked: Optional[MortarCoupling] = None
 
-    def build(self, options: ContactOptions, u) -> GapModel:
+    def build(self, options: ContactOptions, u) -> GapSource:
         model = current_model(options, self.slave, self.master, self.obstacle)
         self._checked = refuse_false_penetration(options, self.slave, self.master, model, u,
                                                  nodal_displacement(self.slave, u))
         return model
 
-    def rebuild(self, options: ContactOptions, u) -> GapModel:
+    def rebuild(self, options: ContactOptions, u) -> GapSource:
         return current_model(options, self.slave, self.master, self.obstacle)
 
-    def frozen_model(self, options: ContactOptions, u) -> Optional[GapModel]:
+    def frozen_model(self, options: ContactOptions, u) -> Optional[GapSource]:
         return self.frozen_model_at(options, nodal_displacement(self.slave, u),
                                     u.x.petsc_vec.copy())
 
     def frozen_model_at(self, options: ContactOptions, u_nodes: FloatArray,
-                        u_vector: PETSc.Vec) -> GapModel:
+                        u_vector: PETSc.Vec) -> GapSource:
         """The model frozen in the configuration ``u_nodes`` (``u_vector`` the
         same as a vector): friction measures a step's slip on the one frozen
         where the step starts."""
         return frozen_model(options, self.slave, self.master, self.obstacle, u_nodes, u_vector)
 
-    def segmentation(self, model: GapModel) -> Optional[MortarCoupling]:
+    def segmentation(self, model: GapSource) -> Optional[MortarCoupling]:
         return self._checked
 
     def geometric_stiffness(self, active: FloatArray, comm: MPI.Comm) -> bool:

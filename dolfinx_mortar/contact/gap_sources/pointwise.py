@@ -9,7 +9,7 @@ MUMPS' LU takes as it is. Moving the boundary of {d > 0} adds nothing to
 ``G⁺`` because the integrand vanishes there.
 
 - Rigid obstacle: cells that the contact boundary cuts are split at d = 0
-  (:mod:`dolfinx_mortar.contact.cut_quadrature`); uncut cells keep their Gauss rule, so
+  (:mod:`dolfinx_mortar.contact.gap_sources.cut_quadrature`); uncut cells keep their Gauss rule, so
   a fully penetrating surface gives the nodal result to round-off.
 - Elastic master: ⟨d⟩ at the segment quadrature points; segments are not
   split (the kink costs quadrature accuracy on the few cut segments only).
@@ -22,14 +22,14 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.cut_quadrature import positive_part_rule
+from dolfinx_mortar.contact.gap_sources.cut_quadrature import positive_part_rule
 from dolfinx_mortar.contact.obstacles import relative_to
-from dolfinx_mortar.contact.penalty_law import positive_part
+from dolfinx_mortar.contact.laws import positive_part
 from dolfinx_mortar.surfaces.lagrange import measure_from_tangents
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 
 if TYPE_CHECKING:
-    from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
+    from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -115,7 +115,7 @@ def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: Fl
 class MortarPointGaps:
     """``d̄⁺`` and ``G⁺`` against an elastic master, from the segment points.
 
-    Small deformation as in :class:`~dolfinx_mortar.contact.gaps.MortarGap`:
+    Small deformation as in :class:`~dolfinx_mortar.contact.gap_sources.frozen.MortarGap`:
     ``d_q(u) = d_q⁰ + n_q·(Σ_B N_B Δu_B − Σ_C N^m_C Δu_C)`` at every segment
     quadrature point q, ``Δu = u − reference``.
     """

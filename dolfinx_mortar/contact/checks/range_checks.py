@@ -16,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
-from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.contact.gap_sources import ContactState
 from dolfinx_mortar.kinds import DUAL_KINDS
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.tolerance import length_scale, zero_length
@@ -38,7 +38,8 @@ SLIP_LIMIT = 1.0
 #: how many times a default search radius is widened (×4 each) before the
 #: contact zone's reaching it is only warned about
 MAX_RADIUS_WIDENINGS = 3
-logger = logging.getLogger(__name__)
+#: the checks' logger is named after the package, where users look for it
+logger = logging.getLogger("dolfinx_mortar.contact.checks")
 
 
 def body_penetration(term) -> tuple[float, float, list]:
@@ -48,7 +49,7 @@ def body_penetration(term) -> tuple[float, float, list]:
     reference coordinates).
 
     The contact holds only the slave surface's nodes
-    (:meth:`~dolfinx_mortar.contact.results.ContactResults.penetration`);
+    (:meth:`~dolfinx_mortar.contact.results.contact_results.ContactResults.penetration`);
     the rest of the mesh may pass through the obstacle where the slave
     surface does not reach, or when the body folds through itself under a
     load far beyond a small-strain model's range (a cylinder on a plane at

@@ -51,10 +51,10 @@ class AugmentedNewtonStep:
     def update_from(self, A: PETSc.Mat, state, model, active: FloatArray,
                     tangential=None) -> None:
         """:meth:`update` from the bulk matrix ``A`` and a GLS model's state
-        (:class:`~dolfinx_mortar.contact.global_gap.GlobalGap`); ``active`` as H(d̄).
+        (:class:`~dolfinx_mortar.contact.gap_sources.global_gap.GlobalGap`); ``active`` as H(d̄).
         The pointwise set puts Ĝ⁺ in the last row while anything penetrates.
         ``tangential``: friction's blocks
-        (:class:`~dolfinx_mortar.contact.friction.AugmentedFriction`), or None."""
+        (:class:`~dolfinx_mortar.contact.friction.tangential.AugmentedFriction`), or None."""
         K = A.copy()
         if state.K_curv is not None:
             K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)

@@ -2,7 +2,7 @@
 
 The only place that chooses among the gap models: the contact term asks for
 "the model of these options in this configuration" and then talks to it
-through :class:`~dolfinx_mortar.contact.state.GapModel` alone.
+through :class:`~dolfinx_mortar.contact.gap_sources.source.GapSource` alone.
 """
 from __future__ import annotations
 
@@ -13,13 +13,13 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
-from dolfinx_mortar.contact.current_mortar import CurrentMortarGap
-from dolfinx_mortar.contact.current_obstacle import CurrentObstacleGap
-from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
-from dolfinx_mortar.contact.global_gap import GlobalGap, covered_mass
+from dolfinx_mortar.contact.gap_sources.current import CurrentMortarGap
+from dolfinx_mortar.contact.gap_sources.current import CurrentObstacleGap
+from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
+from dolfinx_mortar.contact.gap_sources.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
-from dolfinx_mortar.contact.state import GapModel
+from dolfinx_mortar.contact.gap_sources.source import GapSource
 from dolfinx_mortar.kinds import DUAL_KINDS, is_global, kind_name
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
@@ -29,7 +29,7 @@ FloatArray = npt.NDArray[np.float64]
 
 def current_model(options: ContactOptions, slave: LagrangeSurface,
                   master: Optional[LagrangeSurface],
-                  obstacle: Optional[RigidObstacle]) -> GapModel:
+                  obstacle: Optional[RigidObstacle]) -> GapSource:
     """The model with the bases on the current surface, exact Jacobian."""
     if obstacle is not None:
         return CurrentObstacleGap(slave, obstacle, options.kind, options.law)
@@ -38,7 +38,7 @@ def current_model(options: ContactOptions, slave: LagrangeSurface,
 
 def frozen_model(options: ContactOptions, slave: LagrangeSurface,
                  master: Optional[LagrangeSurface], obstacle: Optional[RigidObstacle],
-                 u_nodes: Optional[FloatArray] = None, u_vector=None) -> GapModel:
+                 u_nodes: Optional[FloatArray] = None, u_vector=None) -> GapSource:
     """The model with bases and segmentation frozen in the configuration
     ``u_nodes`` (None: the initial one), linear in u about it (exact in u
     against an obstacle). ``u_vector``: the displacement vector of ``u_nodes``
@@ -69,7 +69,7 @@ def moved(u_nodes: FloatArray, since: Optional[FloatArray], comm: MPI.Comm) -> b
 
 
 def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
-                             master: Optional[LagrangeSurface], current: GapModel, u,
+                             master: Optional[LagrangeSurface], current: GapSource, u,
                              u_nodes: FloatArray) -> Optional[MortarCoupling]:
     """Refuse a dual kind on the current surface against an elastic master
     where it reads a penetration that is not there (NotImplementedError).

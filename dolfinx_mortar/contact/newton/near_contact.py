@@ -14,16 +14,15 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.penalty_law import PenaltyLaw
-from dolfinx_mortar.contact.state import ContactState, GapModel
+from dolfinx_mortar.contact.laws import PenaltyLaw
+from dolfinx_mortar.contact.gap_sources import ContactState, GapSource
+from dolfinx_mortar.tolerance import NEAR_CONTACT
 
 FloatArray = npt.NDArray[np.float64]
 
-#: nodes within this fraction of their element length of contact stiffen when none touches
-NEAR_CONTACT = 0.1
 
 
-def penetrates(model: GapModel, state: ContactState) -> bool:
+def penetrates(model: GapSource, state: ContactState) -> bool:
     """Whether a slave node on any rank penetrates by more than the geometry's
     zero length (collective).
 
@@ -44,7 +43,7 @@ def penetrates(model: GapModel, state: ContactState) -> bool:
     return bool(comm.allreduce(bool(np.any(deep)), op=MPI.LOR))
 
 
-def stiffened_nodes(model: GapModel, state: ContactState,
+def stiffened_nodes(model: GapSource, state: ContactState,
                     near_contact: bool = True) -> FloatArray:
     """Nodes that get contact stiffness in the Jacobian (H(d̄) as 0/1).
 
@@ -105,7 +104,7 @@ class NearContactStiffness:
         #: Newton Jacobians in a row at which nothing penetrated
         self.apart = 0
 
-    def mask(self, model: GapModel, state: ContactState) -> FloatArray:
+    def mask(self, model: GapSource, state: ContactState) -> FloatArray:
         """:func:`stiffened_nodes`, with the near nodes stiffened unless the
         bulk holds the body (collective)."""
         return stiffened_nodes(model, state,
@@ -116,7 +115,7 @@ class NearContactStiffness:
         self.bulk_holds = None
         self.apart = 0
 
-    def due(self, model: GapModel, state: ContactState) -> bool:
+    def due(self, model: GapSource, state: ContactState) -> bool:
         """Count a Newton Jacobian and say whether a decision is due (collective).
 
         One is due at the second Jacobian in a row at which nothing
@@ -139,7 +138,7 @@ class NearContactStiffness:
         near = stiffened_nodes(model, state)[:n]
         return model.slave.layout.comm.allreduce(int(np.sum(near))) > 0
 
-    def decide(self, model: GapModel, state: ContactState,
+    def decide(self, model: GapSource, state: ContactState,
                free: Sequence[PETSc.Vec]) -> bool:
         """Record whether the bulk holds the body: no ``free`` rigid motion
         (dof vectors) changes a near node's gap; returns it (collective)."""
@@ -159,7 +158,7 @@ class NearContactStiffness:
         return self.bulk_holds
 
 
-def gap_closing_force(model: GapModel, state: ContactState) -> Optional[PETSc.Vec]:
+def gap_closing_force(model: GapSource, state: ContactState) -> Optional[PETSc.Vec]:
     """``Gᵀ f`` with ``f`` from ``ω d̄`` on the nodes near contact when nothing
     penetrates yet (:func:`penetrates`; None otherwise).
 

@@ -1,6 +1,6 @@
 """What a contact term reports (``term.results``): gaps, pressures, tractions,
 forces, slip and penetration. The warnings about a configuration that has left
-the model's range are :mod:`~dolfinx_mortar.contact.checks`.
+the model's range are :mod:`~dolfinx_mortar.contact.checks.range_checks`.
 
 Each figure, with what it is:
 
@@ -29,7 +29,7 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.contact.gap_sources import ContactState
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
@@ -193,7 +193,7 @@ class ContactResults:
 
     def slip_states(self, state: Optional[ContactState] = None) -> npt.NDArray[np.int8]:
         """Per local slave-layout node: 0 separated, 1 stick, 2 slip
-        (:data:`~dolfinx_mortar.contact.friction_law.STICK`, …). With the
+        (:data:`~dolfinx_mortar.contact.laws.coulomb.STICK`, …). With the
         nodes' coordinates: :meth:`surface_friction`."""
         return self._friction(state).mapping.state.copy()
 

@@ -14,7 +14,7 @@ configurations are: a rigid translation of both bodies gives no slip, since
 the rows of D̄ and M̄ integrate the same function over the covered part, and
 the mortar weighting makes it independent of where the master mesh's nodes
 lie. Tangential forces follow from the return mapping of
-:mod:`~dolfinx_mortar.contact.friction_law`; with ``f_N = ω⟨y⟩`` the
+:mod:`~dolfinx_mortar.contact.laws.coulomb`; with ``f_N = ω⟨y⟩`` the
 contact's normal nodal forces,
 
 - residual ``R_T = G_Tᵀ f_T`` with ``G_T = ∂Δy_T/∂u`` (linear: frozen
@@ -25,7 +25,7 @@ contact's normal nodal forces,
 GLS and GLS* (gaps ``L⁻¹ĝ`` of the standard basis) measure the slip the same
 way through L: ``Δy_T = P L⁻¹(Ĝ_T Δu − (∫N) Δc)``, residual ``Ĝ_Tᵀ L⁻¹ f_T``;
 their dense tangent is never formed, the augmented Newton system carries it
-(:class:`AugmentedFriction`, :mod:`~dolfinx_mortar.contact.augmented`).
+(:class:`AugmentedFriction`, :mod:`~dolfinx_mortar.contact.newton.augmented`).
 
 On the current surface (``basis_configuration="current"``) the normal contact
 follows u and the slip is measured as above on the model frozen where the
@@ -48,14 +48,14 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.friction_law import SLIP, CoulombFriction, ReturnMapping
-from dolfinx_mortar.contact.friction_state import (  # noqa: F401 (names of this module)
+from dolfinx_mortar.contact.laws import SLIP, CoulombFriction, ReturnMapping
+from dolfinx_mortar.contact.friction.state import (  # noqa: F401 (names of this module)
     AugmentedFriction, FrictionHistory, FrictionState, SlipOperator, check_friction_options,
     lumped_slave_part, solve_components, stacked_identities, tangent_projectors)
-from dolfinx_mortar.contact.gaps import MortarGap, ObstacleGap
+from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
-from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.contact.gap_sources import ContactState
 from dolfinx_mortar.kinds import DUAL_KINDS, is_global
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.linalg.sparse_products import kron_identity, transpose_mat_mult

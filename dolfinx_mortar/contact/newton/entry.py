@@ -5,7 +5,7 @@
 - :class:`AugmentedEntry`: GLS and GLS* have a dense contact stiffness; the
   bulk matrix is left as it is and the exact Newton step comes from a sparse
   augmented system, applied as the KSP's preconditioner
-  (:class:`~dolfinx_mortar.contact.augmented.AugmentedNewtonStep`).
+  (:class:`~dolfinx_mortar.contact.newton.augmented.AugmentedNewtonStep`).
 """
 from __future__ import annotations
 
@@ -16,8 +16,8 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.augmented import AugmentedNewtonStep
-from dolfinx_mortar.contact.state import ContactState, GapModel
+from dolfinx_mortar.contact.newton.augmented import AugmentedNewtonStep
+from dolfinx_mortar.contact.gap_sources import ContactState, GapSource
 from dolfinx_mortar.kinds import BasisKind, is_global
 
 FloatArray = npt.NDArray[np.float64]
@@ -56,7 +56,7 @@ class AssembledEntry:
         #: stiffened (for the contact block preconditioner)
         self.stiffened_rows: np.ndarray = np.zeros(0, dtype=PETSc.IntType)
 
-    def add_pattern(self, A: PETSc.Mat, model: GapModel, state: ContactState,
+    def add_pattern(self, A: PETSc.Mat, model: GapSource, state: ContactState,
                     friction=None) -> None:
         """Give the bulk matrix ``A`` every entry the contact stiffness may have
         (friction's too, where there is friction)."""
@@ -64,10 +64,10 @@ class AssembledEntry:
         if friction is not None:
             A.axpy(1.0, friction.pattern(model, state, state.friction), structure=DIFFERENT)
 
-    def assemble(self, A: PETSc.Mat, model: GapModel, state: ContactState, active: FloatArray,
+    def assemble(self, A: PETSc.Mat, model: GapSource, state: ContactState, active: FloatArray,
                  mask: PETSc.Vec, configuration, friction=None) -> bool:
         """``A += K_c`` at ``state`` with ``active`` as H(d̄) (A assembled after),
-        with ``friction``'s (:class:`~dolfinx_mortar.contact.friction.Friction`)
+        with ``friction``'s (:class:`~dolfinx_mortar.contact.friction.tangential.Friction`)
         stiffness where given; returns whether A's pattern changed unseen by PETSc."""
         geometric = configuration.geometric_stiffness(active, self.comm)
         K = model.jacobian(state, active, mask, geometric=geometric)
@@ -97,11 +97,11 @@ class AugmentedEntry(AssembledEntry):
         #: the exact Newton step of the last :meth:`assemble`
         self.step = AugmentedNewtonStep(comm, self.prefix)
 
-    def add_pattern(self, A: PETSc.Mat, model: GapModel, state: ContactState,
+    def add_pattern(self, A: PETSc.Mat, model: GapSource, state: ContactState,
                     friction=None) -> None:
         """Nothing: the contact stiffness never enters the bulk matrix."""
 
-    def assemble(self, A: PETSc.Mat, model: GapModel, state: ContactState, active: FloatArray,
+    def assemble(self, A: PETSc.Mat, model: GapSource, state: ContactState, active: FloatArray,
                  mask: PETSc.Vec, configuration, friction=None) -> bool:
         tangential = (friction.augmented_blocks(model, state, state.friction, active)
                       if friction is not None else None)

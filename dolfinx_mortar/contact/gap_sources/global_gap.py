@@ -3,7 +3,7 @@
 ``d̄ = L⁻¹ ĝ(u)`` with ``ĝ_B = ∫ N_B d`` (docs/DESIGN.md, §Augmented step). ``M_A`` has global
 support, so ``G = L⁻¹ Ĝ`` is dense: only the sparse ``Ĝ = ∂ĝ/∂u`` and ``L``
 are assembled, and the Newton step solves the augmented system
-(:class:`~dolfinx_mortar.contact.augmented.AugmentedNewtonStep`).
+(:class:`~dolfinx_mortar.contact.newton.augmented.AugmentedNewtonStep`).
 """
 from __future__ import annotations
 
@@ -15,9 +15,9 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.bases.basis import MortarBasis
-from dolfinx_mortar.contact.gaps import GapModelBase
-from dolfinx_mortar.contact.penalty_law import PenaltyLaw
-from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.contact.gap_sources.frozen import GapSourceBase
+from dolfinx_mortar.contact.laws import PenaltyLaw
+from dolfinx_mortar.contact.gap_sources.source import ContactState
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import MassMatrixSolver
 from dolfinx_mortar.mortar.coupling import MortarCoupling
@@ -39,8 +39,8 @@ class GlobalGap:
     """Nodal gaps of GLS and GLS*: ``d̄ = L⁻¹ ĝ(u)``.
 
     ``inner`` is a standard-basis gap model with frozen bases
-    (:class:`~dolfinx_mortar.contact.gaps.ObstacleGap` or
-    :class:`~dolfinx_mortar.contact.gaps.MortarGap` of kind LmLS*) that gives
+    (:class:`~dolfinx_mortar.contact.gap_sources.frozen.ObstacleGap` or
+    :class:`~dolfinx_mortar.contact.gap_sources.frozen.MortarGap` of kind LmLS*) that gives
     ``ĝ`` and ``Ĝ``; ``mass`` the factorized ``L`` and ``lumped_weights`` its
     row sums (over the covered part against an elastic master: with L over
     the whole surface the uncovered part counts as d = 0 and the gaps ring
@@ -50,7 +50,7 @@ class GlobalGap:
 
     moving_pattern = False
 
-    def __init__(self, inner: GapModelBase, law: PenaltyLaw,
+    def __init__(self, inner: GapSourceBase, law: PenaltyLaw,
                  mass: Optional[tuple[MassMatrixSolver, FloatArray]] = None):
         self.inner = inner
         self.law = law

@@ -1,7 +1,7 @@
 """The pieces of Coulomb friction that are not the term itself: the option
 check, the history of accepted steps, a Newton iterate's friction state, the
 slip operator's cache, the augmented system's blocks, and the small nodal
-algebra they share (:mod:`~dolfinx_mortar.contact.friction`, docs/FRICTION.md)."""
+algebra they share (:mod:`~dolfinx_mortar.contact.friction.tangential`, docs/FRICTION.md)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.friction_law import ReturnMapping
+from dolfinx_mortar.contact.laws import ReturnMapping
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.layout import MassMatrixSolver
 
@@ -65,7 +65,7 @@ class FrictionHistory:
 @dataclass
 class FrictionState:
     """Friction at one displacement (part of a
-    :class:`~dolfinx_mortar.contact.state.ContactState`).
+    :class:`~dolfinx_mortar.contact.gap_sources.source.ContactState`).
 
     Attributes
     ----------
@@ -108,7 +108,7 @@ class SlipOperator:
 class AugmentedFriction:
     """Friction's blocks of the GLS kinds' augmented Newton system (rows and
     columns node·gdim + i of the slave layout; see
-    :class:`~dolfinx_mortar.contact.augmented.AugmentedNewtonStep`): with
+    :class:`~dolfinx_mortar.contact.newton.augmented.AugmentedNewtonStep`): with
     ``w = L⁻¹ Ĝ_T Δu`` and ``Δz_T = L⁻¹ Δf_T``, ``Δf_T = PCP w + PBωH Δy``."""
 
     G_T: PETSc.Mat      #: Ĝ_T, Dirichlet columns dropped

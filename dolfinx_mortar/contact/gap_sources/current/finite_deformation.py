@@ -20,13 +20,13 @@ gap are one templated C++ function of the cell's node coordinates
 (``kernels/include/dolfinx_mortar/current_surface.h``), and its Jet
 instantiation gives their exact gradients and Hessians, as the pair kernel
 does for a master's gap; the law's derivatives in ĝ and W are
-:class:`~dolfinx_mortar.contact.penalty_law.PenaltyLaw`'s. This module
+:class:`~dolfinx_mortar.contact.laws.penalty.PenaltyLaw`'s. This module
 assembles them.
 
 :class:`CurrentSurfaceGap` holds what does not depend on where the gap comes
 from (W, the nodal energy, residual and Jacobian assembly);
 :class:`CurrentObstacleGap` takes d from a rigid obstacle and
-:class:`~dolfinx_mortar.contact.current_mortar.CurrentMortarGap` from an elastic
+:class:`~dolfinx_mortar.contact.gap_sources.current.mortar.CurrentMortarGap` from an elastic
 master. GLS/GLS* (L depends on u through every facet) are not covered.
 """
 from __future__ import annotations
@@ -40,9 +40,9 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.contact.gaps import GapModelBase
-from dolfinx_mortar.contact.penalty_law import PenaltyLaw, positive_part, safe_weights
-from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.contact.gap_sources.frozen import GapSourceBase
+from dolfinx_mortar.contact.laws import PenaltyLaw, positive_part, safe_weights
+from dolfinx_mortar.contact.gap_sources.source import ContactState
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, is_global, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
@@ -106,7 +106,7 @@ class CurrentState:
     G_y_plus: Optional[PETSc.Mat] = None
 
 
-class CurrentSurfaceGap(GapModelBase):
+class CurrentSurfaceGap(GapSourceBase):
     """Penalty contact with the bases on the current slave surface (base class).
 
     Subclasses give ``ĝ_A = ∫ φ_A d da`` and its derivatives
@@ -121,7 +121,7 @@ class CurrentSurfaceGap(GapModelBase):
         The mortar kind; GLS kinds are not supported, dual kinds only on P1
         lines and triangles.
     law
-        The penalty law (:class:`~dolfinx_mortar.contact.penalty_law.PenaltyLaw`).
+        The penalty law (:class:`~dolfinx_mortar.contact.laws.penalty.PenaltyLaw`).
         With its pointwise active set (docs/DESIGN.md, §Active sets) the nodal
         pressures come from ``ĝ⁺_A = ∫ φ_A ⟨d⟩ da`` evaluated at the quadrature
         points (cells and segments are not split at d = 0). It has no

@@ -1,0 +1,12 @@
+"""Gap sources: where the nodal gaps d̄, their derivative G and the surface's
+weights come from (docs/DESIGN.md, §Architecture).
+
+Every source implements :class:`GapSource` and returns a :class:`ContactState`;
+the rest of the library asks a source only through that interface. Which
+source a term's options mean is chosen in one place (:mod:`.choice`), and when
+a source's bases are made again is its configuration's (:mod:`.configuration`).
+"""
+from dolfinx_mortar.contact.gap_sources.source import ContactState, GapSource
+from dolfinx_mortar.contact.gap_sources.configuration import configuration_of
+
+__all__ = ["ContactState", "GapSource", "configuration_of"]

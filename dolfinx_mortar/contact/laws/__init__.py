@@ -1,0 +1,8 @@
+"""Contact laws: the normal penalty law and Coulomb friction's return mapping
+(one home per law, docs/DESIGN.md, §Architecture)."""
+from dolfinx_mortar.contact.laws.coulomb import (SEPARATED, SLIP, STICK, CoulombFriction,
+                                                 ReturnMapping)
+from dolfinx_mortar.contact.laws.penalty import PenaltyLaw, positive_part, safe_weights
+
+__all__ = ["CoulombFriction", "PenaltyLaw", "ReturnMapping", "SEPARATED", "SLIP", "STICK",
+           "positive_part", "safe_weights"]

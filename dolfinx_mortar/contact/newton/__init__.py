@@ -1,0 +1,8 @@
+"""How the contact enters Newton: the assembled or augmented entry of its
+stiffness, and the stiffness of the nodes near contact before anything touches."""
+from dolfinx_mortar.contact.newton.entry import entry_of
+from dolfinx_mortar.contact.newton.near_contact import (NearContactStiffness, gap_closing_force,
+                                                        penetrates, stiffened_nodes)
+
+__all__ = ["NearContactStiffness", "entry_of", "gap_closing_force", "penetrates",
+           "stiffened_nodes"]
