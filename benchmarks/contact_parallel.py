@@ -72,7 +72,7 @@ def rank_row(problem, result, wall: float) -> dict:
     """This rank's contact holdings and phase times (s), with the solve's size
     and iteration counts."""
     contact = problem.contact
-    coupling = getattr(contact.model, "coupling", None)
+    coupling = contact.source.coupling
     t = problem.timings
     split = dict(coupling.timings) if coupling is not None else {}
     setup = t.get("contact_setup", 0.0)

@@ -226,7 +226,7 @@ class Holder:
 
 def results(args: argparse.Namespace, contact, ref: dict) -> dict:
     """a, c and the tangential traction's error, gathered on every rank."""
-    comm = contact.mesh.comm
+    comm = contact.comm
     slave = contact.slave
     sphere = args.geometry == "sphere"
     state = contact.evaluate()

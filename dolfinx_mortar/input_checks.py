@@ -83,7 +83,7 @@ def checked_contact_terms(u, contact) -> list:
                                 f"{type(term).__name__}")
             if term.u is not u:
                 raise ValueError("every contact term must be built on the problem's u")
-        if len(contacts) > 1 and any(term.entry.takes_the_linear_solve for term in contacts):
+        if len(contacts) > 1 and any(term.traits.takes_the_linear_solve for term in contacts):
             raise NotImplementedError("a GLS kind (augmented Newton step) must be the only "
                                       "contact term of a problem")
     return contacts

@@ -148,7 +148,7 @@ class ContactProblem:
     @property
     def gap_model(self):
         """The contact term's gap model (:class:`~dolfinx_mortar.contact.gap_sources.source.GapSource`)."""
-        return self.contact.model
+        return self.contact.source
 
     @property
     def timings(self) -> dict:

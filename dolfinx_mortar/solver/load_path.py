@@ -65,7 +65,7 @@ class LoadPathSolver:
                  linear_solver: str = "auto"):
         self.problem = problem
         self.prefix = prefix
-        augmented = any(term.entry.takes_the_linear_solve for term in problem.contacts)
+        augmented = any(term.traits.takes_the_linear_solve for term in problem.contacts)
         gdim = problem.u.function_space.mesh.geometry.dim
         #: "direct" or "iterative", as chosen for this problem
         self.linear_solver = choose_linear_solver(linear_solver, problem.num_dofs, gdim,
@@ -265,7 +265,7 @@ class LoadPathSolver:
                     x.copy(u.x.petsc_vec)
                     u.x.scatter_forward()
                     states = [term.evaluate() for term in self.contacts]
-                    if any([term.checks.widen_search_radius(state)
+                    if any([term.widen_search_radius(state)
                             for term, state in zip(self.contacts, states)]):
                         # the bases were cut off by the search radius: the same step again
                         saved.copy(u.x.petsc_vec)
@@ -290,15 +290,12 @@ class LoadPathSolver:
                     stepper.succeeded()
                     if bar is not None:
                         bar.update(stepper.fraction_of_steps - before)
-                    for term, state in zip(self.contacts, states):
-                        term.checks.warn_if_slipped_too_far(state)
                     if writer is not None:
                         writer.write(target, states)
                     if on_step is not None:
                         on_step(step)
                 for term, worst in zip(self.contacts, deepest):
-                    term.checks.warn_if_the_penalty_is_low(worst)
-                    term.checks.warn_if_the_body_passed_through()
+                    term.check_path(worst)
             finally:
                 if bar is not None:
                     bar.close()

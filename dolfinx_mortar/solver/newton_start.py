@@ -44,13 +44,11 @@ def close_gaps(problem: NonlinearContactProblem, ksp: PETSc.KSP, x: PETSc.Vec) -
     """
     b = problem.vector()
     problem.F(x, b)
-    pulls = [term.gap_closing_force() for term in problem.contacts]
-    if all(p is None for p in pulls):
-        return
-    A = problem.matrix()
     with ExitStack() as stack:
-        for term in problem.contacts:
-            stack.enter_context(term.closing_gaps())
+        pulls = [stack.enter_context(term.closing_gaps()) for term in problem.contacts]
+        if all(p is None for p in pulls):
+            return
+        A = problem.matrix()
         problem.J(x, A, ksp)
     rhs = b.copy()
     for pull in pulls:

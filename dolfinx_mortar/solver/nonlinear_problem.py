@@ -93,6 +93,7 @@ class NonlinearContactProblem:
         self._A: Optional[PETSc.Mat] = None
         self._b: Optional[PETSc.Vec] = None
         self._near_nullspace: Optional[PETSc.NullSpace] = None
+        self._stiffened_rows: list[np.ndarray] = []
         #: give the Jacobian matrix the rigid-body modes (for GAMG; set by the
         #: solver when its preconditioner needs them)
         self.attach_near_nullspace = False
@@ -210,9 +211,9 @@ class NonlinearContactProblem:
 
         for term in self.contacts:
             term.settle_near_contact(free_motions)
-        for term in self.contacts:
-            term.assemble_jacobian(A, self.bcs)
-        if ksp is not None and any(term.pattern_changed for term in self.contacts):
+        assemblies = [term.assemble_jacobian(A, self.bcs) for term in self.contacts]
+        self._stiffened_rows = [assembly.stiffened_rows for assembly in assemblies]
+        if ksp is not None and any(assembly.pattern_changed for assembly in assemblies):
             # a new symbolic factorization (or preconditioner set-up) at the next solve
             ksp.getPC().reset()
 
@@ -252,31 +253,34 @@ class NonlinearContactProblem:
         Dirichlet rows) does not resist
         (:func:`~dolfinx_mortar.linalg.near_nullspace.free_rigid_motions`). Collective."""
         from dolfinx_mortar.linalg.near_nullspace import free_rigid_motions
-        return free_rigid_motions(A, list(self.near_nullspace().getVecs()),
-                                  self.contacts[0].mask(self.bcs).array_r)
+        V = self.u.function_space
+        free = ghosted_vector(V.dofmap.index_map, V.dofmap.index_map_bs)
+        free.set(1.0)
+        fem_petsc.set_bc(free, self.bcs, alpha=0.0)
+        return free_rigid_motions(A, list(self.near_nullspace().getVecs()), free.array_r)
 
     def contact_rows(self) -> np.ndarray:
         """Global indices of this rank's rows that the contact terms stiffened
         at the last :meth:`J` (the exact block of
         :class:`~dolfinx_mortar.linalg.contact_block_pc.ContactBlockPreconditioner`)."""
-        rows = [term.stiffened_rows for term in self.contacts]
+        rows = self._stiffened_rows or [np.zeros(0, dtype=PETSc.IntType)]
         return np.unique(np.concatenate(rows)).astype(PETSc.IntType)
 
     @property
     def symmetric(self) -> bool:
         """Whether the Newton matrix is symmetric: the nodal active set on the
         initial or previous configuration, for every contact term."""
-        return all(term.symmetric for term in self.contacts)
+        return all(term.traits.symmetric for term in self.contacts)
 
     @property
     def current(self) -> bool:
         """Whether a contact term uses the current configuration (two phases per step)."""
-        return any(term.configuration.follows_u for term in self.contacts)
+        return any(term.traits.follows_u for term in self.contacts)
 
     @property
     def frictional(self) -> bool:
         """Whether a contact term has friction."""
-        return any(term.friction is not None for term in self.contacts)
+        return any(term.traits.frictional for term in self.contacts)
 
     @property
     def num_dofs(self) -> int:

@@ -22,7 +22,7 @@ def point_contact(touching_gap: float):
     x = np.column_stack([np.arange(5.0), np.zeros(5)])
     slave = SimpleNamespace(layout=NodeLayout.serial(5), x=x,
                             zero_length=zero_length(length_scale(x)))
-    model = SimpleNamespace(slave=slave, basis=SimpleNamespace(node_lengths=np.full(5, H)))
+    model = SimpleNamespace(slave=slave, node_lengths=np.full(5, H))
     return model, SimpleNamespace(gaps=gaps, gaps_plus=None, covered=np.ones(5, dtype=bool))
 
 

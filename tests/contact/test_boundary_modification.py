@@ -95,7 +95,7 @@ def test_two_touching_cylinders_see_their_true_separation_by_default(axisymmetri
                               axisymmetric=axisymmetric, **options)
         n = contact.slave.layout.num_owned
         gap = contact.results.nodal_gaps()[:n]
-        covered = contact.model.covered[:n]
+        covered = contact.evaluate().covered[:n]
         r = contact.slave.x[:n, 0]
         last = (float(np.max(r[covered], initial=-np.inf)), 0.0)
         if covered.any():

@@ -43,7 +43,7 @@ def term(space, **overrides):
     ("basis_configuration", "initial", "intial", ValueError,
      "unknown basis configuration 'intial'"),
     ("search_radius", None, -1.0, ValueError, "search radius must be positive"),
-    ("friction", None, 0.3, TypeError, "friction must be a CoulombFriction"),
+    ("friction", None, 0.3, TypeError, "friction must be a friction law"),
     ("obstacle", PLANE, RigidPlane([0, 0, 0], [0, 0, 1]), ValueError,
      "a 3D obstacle in a 2D mesh"),
 ])
@@ -76,7 +76,7 @@ def test_a_contact_problem_argument_bad_on_one_rank_raises_on_all(space, overrid
 
 def test_a_term_on_another_u_on_one_rank_raises_on_all(space):
     contact = term(space)
-    u = on_last_rank(contact.u, fem.Function(contact.V))
+    u = on_last_rank(contact.u, fem.Function(contact.u.function_space))
     with pytest.raises(ValueError, match="every contact term must be built on the problem's u"):
         NonlinearContactProblem(ufl_residual(contact.u), u, contact)
 

@@ -71,7 +71,7 @@ def augmented_step_error(problem) -> float:
 def check_both_branches(problem, first, second, cells=None) -> None:
     """Exact at ``first`` (no history) and, after accepting it, at ``second``;
     both with sticking and slipping nodes."""
-    error = (augmented_step_error if problem.contact.entry.takes_the_linear_solve
+    error = (augmented_step_error if problem.contact.traits.takes_the_linear_solve
              else jacobian_error)
     set_displacement(problem, first, cells)
     stick, slip = count_states(problem)

@@ -3,7 +3,7 @@ what the model can represent is warned about (or, for the search radius,
 acted on) instead of solved silently.
 
 Each check is a method of :class:`RangeChecks`, which a term holds as
-``term.checks``: the term where it is made, a load-path driver after each
+the term's: the term where it is made, a load-path driver after each
 converged step and at the end of a solve.
 """
 from __future__ import annotations
@@ -59,10 +59,10 @@ def body_penetration(term) -> tuple[float, float, list]:
     is measured: (-inf, 0, []).
     """
     obstacle = term.obstacle
-    comm = term.mesh.comm
+    comm = term.comm
     if obstacle is None:
         return (-np.inf, 0.0, [])
-    V = term.V
+    V = term.u.function_space
     gdim = term.slave.gdim
     owned = V.dofmap.index_map.size_local
     X_all = V.tabulate_dof_coordinates()[:, :gdim]
@@ -89,10 +89,12 @@ def body_penetration(term) -> tuple[float, float, list]:
 
 
 class RangeChecks:
-    """The checks of one contact term (``term.checks``); each warns once."""
+    """The checks of one contact term (the term's); each warns once."""
 
-    def __init__(self, term):
+    def __init__(self, term, configuration):
         self.term = term
+        #: where the term's bases live (whether its pairs are found once, follow u, …)
+        self.configuration = configuration
         self._slip_warned = False
         self._body_warned = False
         #: (coupling, slave nodes a four times wider search pairs) of the last check
@@ -170,7 +172,7 @@ class RangeChecks:
             return
         self._body_warned = True
         held, _, _ = self.term.results.penetration()
-        if self.term.mesh.comm.rank == 0:
+        if self.term.comm.rank == 0:
             where = ", ".join(f"{c:.4g}" for c in x)
             logger.warning(
                 "at convergence a node off the slave surface has passed through the obstacle "
@@ -189,7 +191,7 @@ class RangeChecks:
         normal force growing 3× and a frictionless tangential force of 33% of
         it without a word. Against a rigid obstacle the gap is exact in u
         whatever the slip (no segmentation is frozen): no warning."""
-        if (not self.term.configuration.pairs_found_once or self.term.obstacle is not None
+        if (not self.configuration.pairs_found_once or self.term.obstacle is not None
                 or self._slip_warned):
             return
         s = self.term.results.slip(state)
@@ -215,7 +217,7 @@ class RangeChecks:
         """
         if self.term.master is None:
             return
-        comm = self.term.mesh.comm
+        comm = self.term.comm
         radius = self.term.options.search_radius
         if coupling is None:        # the current surface: one segmentation for this check
             coupling = MortarCoupling(self.term.slave, self.term.master, search_radius=radius)
@@ -234,7 +236,7 @@ class RangeChecks:
                           stacklevel=3)
             return
         never = (" With basis_configuration='initial' the pairs are found only here, so "
-                 "it never will." if self.term.configuration.pairs_found_once else "")
+                 "it never will." if self.configuration.pairs_found_once else "")
         warnings.warn(f"no slave facet finds a master facet within the search radius "
                       f"{radius:.3g} along its normal: the contact cannot act until the "
                       f"surfaces come within it.{never} Check the slave and master tags and "
@@ -253,10 +255,10 @@ class RangeChecks:
         graded to h = a/40 lost the outer fifth of the contact zone that way and
         had the pressure 51% off.
         """
-        if self.term.master is None or self.term.configuration.follows_u:
+        if self.term.master is None or self.configuration.follows_u:
             return False
-        model, slave = self.term.model, self.term.slave
-        comm = self.term.mesh.comm
+        model, slave = self.term.source, self.term.slave
+        comm = self.term.comm
         state = state or self.term.evaluate()
         covered = state.covered
         cells = slave.cells
@@ -291,13 +293,13 @@ class RangeChecks:
         if self._radius_warned or not self.contact_reached_the_search_radius(state):
             return False
         term = self.term
-        radius = term.model.coupling.search_radius
+        radius = term.source.coupling.search_radius
         widenings = self._radius_widenings
         if term.options.search_radius is None or widenings > 0:
             if widenings < MAX_RADIUS_WIDENINGS:
                 self._radius_widenings = widenings + 1
                 term.rebuild(4 * radius)
-                if term.mesh.comm.rank == 0:
+                if term.comm.rank == 0:
                     logger.info("the contact zone reached slave nodes with no master within "
                                 "the search radius %.3g: bases rebuilt with %.3g, step "
                                 "solved again", radius, 4 * radius)

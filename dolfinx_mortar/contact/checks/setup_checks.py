@@ -46,7 +46,7 @@ def warn_if_the_obstacle_faces_away(obstacle, slave, comm: MPI.Comm) -> None:
 OVERLAP_SEARCH_FACTORS = (4.0, 16.0)
 
 
-def check_initial_overlap(term, coupling) -> None:
+def check_initial_overlap(term, coupling, built_at_u: bool) -> None:
     """Refuse a slave body that starts inside the master beyond the search radius.
 
     Against an elastic master whose segmentation ``coupling`` paired no facet,
@@ -55,16 +55,17 @@ def check_initial_overlap(term, coupling) -> None:
     surface by more than DEEP_PENETRATION slave element lengths
     (:mod:`~dolfinx_mortar.contact.checks.range_checks`), the bodies overlap. Two blocks
     overlapping by two elements were reported as out of reach (collective).
+    ``built_at_u``: the segmentation was made at the present u (not at u = 0).
 
     Raises
     ------
     ValueError
         Naming the depth and a slave node, on every rank.
     """
-    comm = term.mesh.comm
+    comm = term.comm
     if term.master is None or coupling is None or comm.allreduce(len(coupling.pairs)) > 0:
         return
-    moved = term.configuration.built_at_u
+    moved = built_at_u
     displacements = ([nodal_displacement(surface, term.u) for surface in (term.slave, term.master)]
                      if moved else [None, None])
     for factor in OVERLAP_SEARCH_FACTORS:

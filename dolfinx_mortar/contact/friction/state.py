@@ -92,19 +92,6 @@ class FrictionState:
 
 
 @dataclass
-class SlipOperator:
-    """The linear map of a step: ``Δy_T = to_local(G_T Δu) − obstacle_weights Δc``;
-    with ``mass`` (GLS, GLS*) ``Δy_T = P L⁻¹(Ĝ_T Δu − (∫N) Δc)``, G_T then
-    the standard basis's unprojected ``Ĝ_T``."""
-
-    G_T: PETSc.Mat
-    projectors: FloatArray              # P_A, (nodes, gdim, gdim)
-    obstacle_weights: Optional[FloatArray]  # (∫ M̄_A) P_A for the obstacle's motion
-    weights: FloatArray                 # ω = ε W^m of the model it was made from
-    mass: Optional[MassMatrixSolver] = None  # L of the global kinds
-
-
-@dataclass
 class AugmentedFriction:
     """Friction's blocks of the GLS kinds' augmented Newton system (rows and
     columns node·gdim + i of the slave layout; see
@@ -117,39 +104,6 @@ class AugmentedFriction:
     L: PETSc.Mat        #: L ⊗ I_gdim
 
 
-def tangent_projectors(normals: FloatArray) -> FloatArray:
-    gdim = normals.shape[1]
-    return np.eye(gdim)[None] - normals[:, :, None] * normals[:, None, :]
-
-
-def stacked_identities(projectors: FloatArray) -> FloatArray:
-    return np.broadcast_to(np.eye(projectors.shape[1]), projectors.shape)
-
-
 def solve_components(mass: MassMatrixSolver, values: FloatArray) -> FloatArray:
     """``L⁻¹`` applied to each component of nodal vectors (nodes, gdim)."""
     return np.stack([mass.solve(values[:, i]) for i in range(values.shape[1])], axis=1)
-
-
-def lumped_slave_part(blocks: FloatArray, slave_nodes: int) -> FloatArray:
-    """The scalar slip couplings ``[D̄ | −M̄]`` (cells, rows, columns) with the
-    slave part ``D̄`` lumped onto its diagonal (row sums ``∫ M̄_A`` kept).
-
-    For LmLS and LmLS* ``D̄_AB = ∫ M̄_A N_B`` couples each node to its
-    neighbours (a row-scaled consistent mass, 1/6 : 2/3 : 1/6 on a uniform
-    line), and with it the nodal Coulomb conditions are set on an average of
-    the neighbours' slips. Newton's stick/slip iteration then ran away: on a
-    block pushed sideways at 0.2 of its load (μ = 0.3, ε = 1e3 E/h) the slip
-    of the slipping zone reversed from one iteration to the next, hundreds of
-    stick bands deep, and it stalled at every increment (a first step from
-    rest is the same problem at any load). The dual kinds' D̄ is diagonal
-    already (biorthogonality) and they converged in 4–5 iterations; lumped,
-    LmLS(*) converge in the same (docs/FRICTION.md). The row sums keep the
-    slip objective for rigid translations, and the master part stays the
-    mortar integral.
-    """
-    slave, master = blocks[:, :, :slave_nodes], blocks[:, :, slave_nodes:]
-    diagonal = np.zeros_like(slave)
-    rows = np.arange(slave.shape[1])
-    diagonal[:, rows, rows] = slave.sum(axis=2)
-    return np.concatenate([diagonal, master], axis=2)

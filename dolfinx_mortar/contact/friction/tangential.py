@@ -41,22 +41,20 @@ when a step has converged: a cut-back retries from the same history.
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Optional
+from typing import Optional
 
 import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.laws import SLIP, CoulombFriction, ReturnMapping
-from dolfinx_mortar.contact.friction.state import (  # noqa: F401 (names of this module)
-    AugmentedFriction, FrictionHistory, FrictionState, SlipOperator, check_friction_options,
-    lumped_slave_part, solve_components, stacked_identities, tangent_projectors)
-from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
+from dolfinx_mortar.contact.laws import SLIP, ReturnMapping, TangentialLaw
+from dolfinx_mortar.contact.friction.state import (AugmentedFriction, FrictionHistory,
+                                                   FrictionState, check_friction_options,
+                                                   solve_components)
+from dolfinx_mortar.contact.gap_sources import ContactState, GapSource, SlipOperator, StepStart
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
-from dolfinx_mortar.contact.gap_sources import ContactState
-from dolfinx_mortar.kinds import DUAL_KINDS, is_global
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.linalg.sparse_products import kron_identity, transpose_mat_mult
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
@@ -68,10 +66,16 @@ DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 class Friction:
     """Coulomb friction of one contact term (see the module).
 
+    Friction asks the term's gap source only through the
+    :class:`~dolfinx_mortar.contact.gap_sources.GapSource` interface: its
+    slip operator (:meth:`~dolfinx_mortar.contact.gap_sources.GapSource.slip_operator`),
+    the derivative of its normal forces and its dof layout.
+
     Parameters
     ----------
     law
-        μ and ε_T.
+        The friction law (:class:`~dolfinx_mortar.contact.laws.TangentialLaw`:
+        Coulomb's μ and ε_T, or another).
     options
         The contact term's options (checked here for what friction supports).
     u
@@ -80,118 +84,55 @@ class Friction:
         The slave surface (:class:`~dolfinx_mortar.surfaces.lagrange.LagrangeSurface`).
     obstacle
         The term's rigid obstacle, or None.
-    step_start_model
-        On the current surface: makes the model frozen in a configuration
-        (nodal displacement, the same as a vector), on which each step's slip
-        is measured; None where the term's own model is frozen.
     """
 
-    def __init__(self, law: CoulombFriction, options: ContactOptions, u, slave,
-                 obstacle: Optional[RigidObstacle] = None,
-                 step_start_model: Optional[Callable[[FloatArray, PETSc.Vec], Any]] = None):
+    def __init__(self, law: TangentialLaw, options: ContactOptions, u, slave,
+                 obstacle: Optional[RigidObstacle] = None):
         check_friction_options(options)
         self.law = law
         self.normal_law = options.law
         #: ε_T
         self.penalty = law.penalty(options.penalty)
         self.slave, self.obstacle = slave, obstacle
-        #: LmLS, LmLS*: the slip of a node from its own displacement (see
-        #: :func:`lumped_slave_part`)
-        self._lumped = options.kind not in DUAL_KINDS and not is_global(options.kind)
         self.comm: MPI.Comm = slave.layout.comm
         u.x.scatter_forward()
         self.history = FrictionHistory(
             np.zeros((slave.layout.size_local, slave.gdim)), u.x.petsc_vec.copy(),
             nodal_displacement(slave, u),
             None if obstacle is None else np.array(obstacle.displacement, dtype=float))
-        self._step_start_model = step_start_model
         self._operator: Optional[SlipOperator] = None
         #: the stick/slip states and slip directions of the last Jacobian (the
         #: exact slip tangent once they repeat)
         self._jacobian_states: Optional[tuple[npt.NDArray[np.int8], FloatArray]] = None
-        #: the model and the step the slip operator was made for
+        #: the source and the step the slip operator was made for
         self._operator_for: tuple = (None, -2)
 
-    # -- the slip operator of a step ---------------------------------------------------
-    def _slip_operator(self, model) -> SlipOperator:
-        """The slip operator of the present step: made again for a new model
-        and, against an obstacle (whose tangent planes are those where the step
-        starts), for every new step; on the current surface from the model
-        frozen where the step starts, for every new step."""
+    def _slip_operator(self, source: GapSource) -> SlipOperator:
+        """The slip operator of the present step: made again for a new source,
+        and for every new step where the source says so (an obstacle's tangent
+        planes, the current surface frozen where the step starts)."""
         h = self.history
-        if self._step_start_model is not None:
-            model, key = None, (None, h.version)
-        else:
-            source = getattr(model, "inner", model)
-            key = (model, h.version if isinstance(source, ObstacleGap) else -1)
-        made_for, made_at = self._operator_for
-        if self._operator is None or made_for is not key[0] or made_at != key[1]:
-            if model is None:
-                model = self._step_start_model(h.u_nodes, h.u.copy())
-            # GLS, GLS*: the standard basis's integrals, projected after L⁻¹
-            inner = getattr(model, "inner", None)
-            source = model if inner is None else inner
-            project = inner is None
-            self._operator = (self._obstacle_operator(source, project)
-                              if isinstance(source, ObstacleGap)
-                              else self._mortar_operator(source, project))
-            if inner is not None:
-                self._operator.mass, self._operator.weights = model.mass, model.weights
+        key = (source, h.version if source.slip_operator_per_step else -1)
+        if self._operator is None or self._operator_for[0] is not key[0] \
+                or self._operator_for[1] != key[1]:
+            start = StepStart(h.u_nodes, h.u, h.obstacle_displacement)
+            self._operator = source.slip_operator(start)
             self._operator_for = key
         return self._operator
 
-    def _assemble(self, model, cells, cols, blocks, projectors) -> PETSc.Mat:
-        """G_T from scalar node couplings ``blocks`` (cells, rows, cols) times P_A."""
-        gdim = self.slave.gdim
-        nc, nr = cells.shape
-        values = np.einsum("can,caik->caink", blocks, projectors[cells])
-        rows = (cells[..., None] * gdim + np.arange(gdim)).reshape(nc, nr * gdim)
-        return assemble_blocks(model.dofs, rows, model.dofs, cols,
-                               values.reshape(nc, nr * gdim, cols.shape[1]))
-
-    def _mortar_operator(self, model: MortarGap, project: bool) -> SlipOperator:
-        cells, cols, blocks = model.pair_operators
-        if self._lumped and project:
-            blocks = lumped_slave_part(blocks, cells.shape[1])
-        projectors = tangent_projectors(model.coupling.normals)
-        applied = projectors if project else stacked_identities(projectors)
-        return SlipOperator(self._assemble(model, cells, cols, blocks, applied),
-                             projectors, None, model.weights)
-
-    def _obstacle_operator(self, model: ObstacleGap, project: bool) -> SlipOperator:
-        """Tangent planes of the obstacle below each node where the step starts
-        (the obstacle translated back to where it was then)."""
-        h = self.history
-        u_nodes = h.u_nodes if model.reference is None else h.u_nodes - model.reference
-        tab, cells = model.tabulation, model.slave.cells
-        nodes = np.unique(cells)
-        back = np.asarray(self.obstacle.displacement) - h.obstacle_displacement
-        normals = np.zeros_like(u_nodes)
-        normals[nodes] = self.obstacle.gradient(model.slave.x[nodes] + u_nodes[nodes] + back)
-        projectors = tangent_projectors(normals)
-        blocks = np.einsum("cq,cqa,cqb->cab", tab.weights, model.Mbar, tab.phi)
-        if self._lumped and project:
-            blocks = lumped_slave_part(blocks, blocks.shape[2])
-        nc, nd = cells.shape
-        cols = model.node_dofs(cells).reshape(nc, nd * self.slave.gdim)
-        mass = self.slave.layout.sum_at_functions(cells, blocks.sum(axis=2))
-        applied = projectors if project else stacked_identities(projectors)
-        return SlipOperator(self._assemble(model, cells, cols, blocks, applied),
-                             projectors, mass[:, None, None] * applied, model.weights)
-
     # -- evaluation --------------------------------------------------------------------
-    def evaluate(self, model, state: ContactState, u, active: FloatArray,
+    def evaluate(self, source: GapSource, state: ContactState, u, active: FloatArray,
                  mask: Optional[PETSc.Vec]) -> FrictionState:
         """Friction at the displacement Function ``u`` with the normal state
         ``state`` and ``active`` (0/1 per node, the nodes stiffened normally)."""
-        operator = self._slip_operator(model)
+        operator = self._slip_operator(source)
         h = self.history
         du = u.x.petsc_vec.copy()
         du.axpy(-1.0, h.u)
         Gdu = operator.G_T.createVecLeft()
         operator.G_T.mult(du, Gdu)
         gdim = self.slave.gdim
-        slip = model.dofs.to_local(Gdu).reshape(-1, gdim)
+        slip = operator.dofs.to_local(Gdu).reshape(-1, gdim)
         for v in (du, Gdu):
             v.destroy()
         if operator.obstacle_weights is not None:
@@ -220,29 +161,29 @@ class Friction:
         f.destroy()
         return FrictionState(slip, mapping, G_T, weights, history, residual)
 
-    def _node_blocks(self, model, values: FloatArray, columns: str) -> PETSc.Mat:
+    def _node_blocks(self, source: GapSource, values: FloatArray, columns: str) -> PETSc.Mat:
         """A matrix of one block per owned slave-surface node: (gdim × gdim)
         on the dofs (``columns="dofs"``) or (gdim × 1) on the node
         (``columns="nodes"``)."""
-        layout, gdim = self.slave.layout, self.slave.gdim
+        layout, gdim, dofs_layout = self.slave.layout, self.slave.gdim, source.dofs
         nodes = np.unique(self.slave.cells)
         nodes = nodes[nodes < layout.num_owned]
         rows = nodes[:, None] * gdim + np.arange(gdim)
         if columns == "dofs":
             dofs = layout.global_indices[nodes][:, None] * gdim + np.arange(gdim)
-            return assemble_blocks(model.dofs, rows, model.dofs, dofs, values[nodes])
-        return assemble_blocks(model.dofs, rows, layout, layout.global_indices[nodes][:, None],
+            return assemble_blocks(dofs_layout, rows, dofs_layout, dofs, values[nodes])
+        return assemble_blocks(dofs_layout, rows, layout, layout.global_indices[nodes][:, None],
                                values[nodes][:, :, None])
 
-    def jacobian(self, model, state: ContactState, friction: FrictionState,
+    def jacobian(self, source: GapSource, state: ContactState, friction: FrictionState,
                  active: FloatArray) -> PETSc.Mat:
         """``K_T = G_Tᵀ (C_TT G_T + c_TN ⊗ ∂f_N/∂u)`` at ``friction``."""
         mapping = friction.mapping
         tangent = self._tangent(mapping, friction.tangential_weights)
-        return self._product(model, friction, tangent, mapping.normal_tangent,
-                             model.normal_force_derivative(state, active))
+        return self._product(source, friction, tangent, mapping.normal_tangent,
+                             source.normal_force_derivative(state, active))
 
-    def augmented_blocks(self, model, state: ContactState, friction: FrictionState,
+    def augmented_blocks(self, source: GapSource, state: ContactState, friction: FrictionState,
                          active: FloatArray) -> AugmentedFriction:
         """Friction's blocks of the GLS kinds' augmented Newton system at ``friction``."""
         mapping = friction.mapping
@@ -251,9 +192,9 @@ class Friction:
                         self._tangent(mapping, friction.tangential_weights), P)
         PB = np.einsum("aij,aj->ai", P, mapping.normal_tangent) * \
             (state.weights * active)[:, None]
-        return AugmentedFriction(friction.G_T, self._node_blocks(model, PCP, "dofs"),
-                                 self._node_blocks(model, PB, "nodes"),
-                                 kron_identity(model.mass.matrix, self.slave.gdim))
+        return AugmentedFriction(friction.G_T, self._node_blocks(source, PCP, "dofs"),
+                                 self._node_blocks(source, PB, "nodes"),
+                                 kron_identity(self._operator.mass.matrix, self.slave.gdim))
 
     def _tangent(self, mapping: ReturnMapping, tangential_weights: FloatArray) -> FloatArray:
         """The return mapping's tangent for Newton: the secant while the
@@ -285,12 +226,12 @@ class Friction:
             tangent[turned] = tangential_weights[turned, None, None] * np.eye(tangent.shape[1])
         return tangent
 
-    def _product(self, model, friction: FrictionState, tangent: FloatArray,
+    def _product(self, source: GapSource, friction: FrictionState, tangent: FloatArray,
                  normal_tangent: FloatArray, D: PETSc.Mat) -> PETSc.Mat:
         """``G_Tᵀ (C G_T + B D)`` with node blocks C = ``tangent`` and B =
         ``normal_tangent``, and ``D = ∂f_N/∂u``."""
-        C = self._node_blocks(model, tangent, "dofs")
-        B = self._node_blocks(model, normal_tangent, "nodes")
+        C = self._node_blocks(source, tangent, "dofs")
+        B = self._node_blocks(source, normal_tangent, "nodes")
         J = C.matMult(friction.G_T)
         BD = B.matMult(D)
         J.axpy(1.0, BD, structure=DIFFERENT)
@@ -299,12 +240,12 @@ class Friction:
             m.destroy()
         return K
 
-    def pattern(self, model, state: ContactState, friction: FrictionState) -> PETSc.Mat:
+    def pattern(self, source: GapSource, state: ContactState, friction: FrictionState) -> PETSc.Mat:
         """Every entry :meth:`jacobian` may have (stick and slip at every node)."""
         gdim = self.slave.gdim
         n = self.slave.layout.size_local
-        return self._product(model, friction, np.ones((n, gdim, gdim)), np.ones((n, gdim)),
-                             model.normal_force_derivative(state, np.ones(n)))
+        return self._product(source, friction, np.ones((n, gdim, gdim)), np.ones((n, gdim)),
+                             source.normal_force_derivative(state, np.ones(n)))
 
     # -- the history -------------------------------------------------------------------
     def accept(self, friction: FrictionState, u) -> None:

@@ -6,7 +6,8 @@ the rest of the library asks a source only through that interface. Which
 source a term's options mean is chosen in one place (:mod:`.choice`), and when
 a source's bases are made again is its configuration's (:mod:`.configuration`).
 """
-from dolfinx_mortar.contact.gap_sources.source import ContactState, GapSource
+from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
+from dolfinx_mortar.contact.gap_sources.source import ContactState, GapSource, GlobalGapSource
 from dolfinx_mortar.contact.gap_sources.configuration import configuration_of
 
-__all__ = ["ContactState", "GapSource", "configuration_of"]
+__all__ = ["ContactState", "GapSource", "GlobalGapSource", "SlipOperator", "StepStart", "configuration_of"]

@@ -7,6 +7,7 @@ through :class:`~dolfinx_mortar.contact.gap_sources.source.GapSource` alone.
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 from typing import Optional
 
 import numpy as np
@@ -30,10 +31,14 @@ FloatArray = npt.NDArray[np.float64]
 def current_model(options: ContactOptions, slave: LagrangeSurface,
                   master: Optional[LagrangeSurface],
                   obstacle: Optional[RigidObstacle]) -> GapSource:
-    """The model with the bases on the current surface, exact Jacobian."""
+    """The model with the bases on the current surface, exact Jacobian; friction
+    measures each step's slip on the frozen model where the step starts."""
     if obstacle is not None:
-        return CurrentObstacleGap(slave, obstacle, options.kind, options.law)
-    return CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius)
+        model = CurrentObstacleGap(slave, obstacle, options.kind, options.law)
+    else:
+        model = CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius)
+    model.frozen_at = partial(frozen_model, options, slave, master, obstacle)
+    return model
 
 
 def frozen_model(options: ContactOptions, slave: LagrangeSurface,

@@ -159,15 +159,8 @@ class CurrentConfiguration(InitialConfiguration):
         return current_model(options, self.slave, self.master, self.obstacle)
 
     def frozen_model(self, options: ContactOptions, u) -> Optional[GapSource]:
-        return self.frozen_model_at(options, nodal_displacement(self.slave, u),
-                                    u.x.petsc_vec.copy())
-
-    def frozen_model_at(self, options: ContactOptions, u_nodes: FloatArray,
-                        u_vector: PETSc.Vec) -> GapSource:
-        """The model frozen in the configuration ``u_nodes`` (``u_vector`` the
-        same as a vector): friction measures a step's slip on the one frozen
-        where the step starts."""
-        return frozen_model(options, self.slave, self.master, self.obstacle, u_nodes, u_vector)
+        return frozen_model(options, self.slave, self.master, self.obstacle,
+                            nodal_displacement(self.slave, u), u.x.petsc_vec.copy())
 
     def segmentation(self, model: GapSource) -> Optional[MortarCoupling]:
         return self._checked

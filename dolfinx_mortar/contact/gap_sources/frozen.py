@@ -38,6 +38,9 @@ from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle, relative_to
 from dolfinx_mortar.contact.gap_sources.pointwise import MortarPointGaps, obstacle_positive_gaps
+from dolfinx_mortar.contact.gap_sources.slip import (SlipOperator, StepStart,
+                                                     mortar_slip_operator, obstacle_slip_operator)
+from dolfinx_mortar.kinds import DUAL_KINDS, is_global
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.linalg.sparse_products import TransposeProduct, transpose_mat_mult
 from dolfinx_mortar.tolerance import local_origin
@@ -59,6 +62,8 @@ class GapSourceBase:
     moving_pattern = False
     #: the segmentation against an elastic master (None against an obstacle)
     coupling = None
+    #: the slip operator is made again at every load step (False: once per source)
+    slip_operator_per_step = False
 
     def __init__(self, slave: LagrangeSurface, law: PenaltyLaw):
         self.slave = slave
@@ -74,6 +79,14 @@ class GapSourceBase:
         #: M̄ = N_std C_std on each slave cell (N_std: the displacement's basis)
         self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
         self._stiffness_product = TransposeProduct()
+        #: LmLS, LmLS*: the slip of a node from its own displacement (see
+        #: :func:`~dolfinx_mortar.contact.gap_sources.slip.lumped_slave_part`)
+        self.lumped_slip = law.gap_kind not in DUAL_KINDS and not is_global(law.gap_kind)
+
+    @property
+    def node_lengths(self) -> FloatArray:
+        """An element length per slave node (the scale of "near contact")."""
+        return self.basis.node_lengths
 
     @property
     def lumped_weights(self) -> FloatArray:
@@ -167,6 +180,9 @@ class ObstacleGap(GapSourceBase):
     Exact in u (no segmentation: the obstacle lies below every slave point).
     """
 
+    #: the tangent planes are the obstacle's where each step starts
+    slip_operator_per_step = True
+
     def __init__(self, slave: LagrangeSurface, obstacle: RigidObstacle, law: PenaltyLaw,
                  quadrature_degree: Optional[int] = None,
                  reference: Optional[FloatArray] = None):
@@ -186,6 +202,11 @@ class ObstacleGap(GapSourceBase):
         self.Mbar = np.einsum("cqb,cba->cqa", tab.phi, self.coefficients_std)
         #: slave nodes with something below them (here: all; the obstacle is unbounded)
         self.covered = slave.layout.on_cells(slave.cells)
+
+    def slip_operator(self, start: StepStart, project: bool = True) -> SlipOperator:
+        """Friction's slip operator of the step from ``start`` (``project``
+        False: unprojected, for GLS)."""
+        return obstacle_slip_operator(self, self.obstacle, start, self.lumped_slip, project)
 
     def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
         """The contact state at the displacement Function ``u``."""
@@ -314,6 +335,11 @@ class MortarGap(GapSourceBase):
         self.points = None
         if self.pointwise:
             self.points = MortarPointGaps(self)
+
+    def slip_operator(self, start: StepStart, project: bool = True) -> SlipOperator:
+        """Friction's slip operator (``[D̄ | −M̄]`` and the segmentation's
+        normals, frozen with the bases; ``project`` False: unprojected, for GLS)."""
+        return mortar_slip_operator(self, self.lumped_slip, project)
 
     def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
         """The contact state at the displacement Function ``u``."""

@@ -17,6 +17,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.contact.gap_sources.frozen import GapSourceBase
 from dolfinx_mortar.contact.laws import PenaltyLaw
+from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
 from dolfinx_mortar.contact.gap_sources.source import ContactState
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import MassMatrixSolver
@@ -79,6 +80,27 @@ class GlobalGap:
         K_curv = self.inner.curvature(force, x) if x is not None else None
         return replace(self.inner.state(gaps, G, force, mask, gaps_plus, G_plus, K_curv),
                        weights=self.weights, lumped_weights=self.lumped_weights)
+
+    def any_penetration(self, gaps_plus: FloatArray) -> bool:
+        """Whether the pointwise ``d̄⁺`` is nonzero anywhere (collective)."""
+        return self.inner.any_penetration(gaps_plus)
+
+    @property
+    def node_lengths(self) -> FloatArray:
+        """An element length per slave node."""
+        return self.basis.node_lengths
+
+    @property
+    def slip_operator_per_step(self) -> bool:
+        """As the standard-basis source's."""
+        return self.inner.slip_operator_per_step
+
+    def slip_operator(self, start: StepStart, project: bool = True) -> SlipOperator:
+        """The standard basis's unprojected integrals ``Ĝ_T``, with L: the slip
+        is ``P L⁻¹(Ĝ_T Δu − (∫N)Δc)`` (projected after L⁻¹)."""
+        operator = self.inner.slip_operator(start, project=False)
+        operator.mass, operator.weights = self.mass, self.weights
+        return operator
 
     def nodal_force(self, values: FloatArray) -> FloatArray:
         """``z = L⁻¹ values``: the nodal force of ``R_c = Ĝᵀ z``."""

@@ -15,6 +15,8 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.contact.gap_sources import ContactState, GlobalGapSource
+
 FloatArray = npt.NDArray[np.float64]
 
 
@@ -48,7 +50,8 @@ class AugmentedNewtonStep:
         #: wall time of the factorizations (a linear-solve cost spent in the Jacobian callback)
         self.factorization_time = 0.0
 
-    def update_from(self, A: PETSc.Mat, state, model, active: FloatArray,
+    def update_from(self, A: PETSc.Mat, state: ContactState, model: GlobalGapSource,
+                    active: FloatArray,
                     tangential=None) -> None:
         """:meth:`update` from the bulk matrix ``A`` and a GLS model's state
         (:class:`~dolfinx_mortar.contact.gap_sources.global_gap.GlobalGap`); ``active`` as H(d̄).
@@ -59,7 +62,7 @@ class AugmentedNewtonStep:
         if state.K_curv is not None:
             K.axpy(1.0, state.K_curv, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         G_right, weights = state.G, state.weights * active
-        if state.gaps_plus is not None and model.inner.any_penetration(state.gaps_plus):
+        if state.gaps_plus is not None and model.any_penetration(state.gaps_plus):
             G_right, weights = state.G_plus, state.weights
         self.update(K, state.G, weights, model.mass.matrix, G_right, model.surface_rows,
                     tangential)

@@ -59,7 +59,7 @@ def stiffened_nodes(model: GapSource, state: ContactState,
     covered = state.covered
     active = covered & PenaltyLaw.active(state.gaps)
     if near_contact and not penetrates(model, state):
-        active = covered & (state.gaps >= -NEAR_CONTACT * model.basis.node_lengths)
+        active = covered & (state.gaps >= -NEAR_CONTACT * model.node_lengths)
     return active.astype(np.float64)
 
 

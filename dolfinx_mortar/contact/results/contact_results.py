@@ -97,7 +97,7 @@ class ContactResults:
 
     def nodal_pressures(self, state: Optional[ContactState] = None) -> FloatArray:
         """Contact pressure ``p_A`` at the local slave-layout nodes (0 off the surface)."""
-        return self.term.model.nodal_pressures(state or self.term.evaluate())
+        return self.term.source.nodal_pressures(state or self.term.evaluate())
 
     def surface_pressure(self, state: Optional[ContactState] = None,
                          gather: bool = False) -> SurfacePressure:
@@ -128,7 +128,7 @@ class ContactResults:
         part = (slave.x[nodes], [v[nodes] for v in values], layout.global_indices[nodes])
         if not gather:
             return (part[0], *part[1], part[2])
-        parts = self.term.mesh.comm.allgather(part)
+        parts = self.term.comm.allgather(part)
         x = np.concatenate([q[0] for q in parts]).reshape(-1, slave.gdim)
         # coordinates equal up to round-off (a mesh generator's 0 may be -2e-18) are equal
         # here, so that the order does not depend on where round-off lands
@@ -140,14 +140,14 @@ class ContactResults:
     def mortar_traction(self, state: Optional[ContactState] = None) -> FloatArray:
         """The contact traction ``p*`` at the nodes of every slave cell, (cells, nodes):
         one set per cell, since ``p*`` of the dual kinds jumps between cells."""
-        return self.term.model.mortar_traction(state or self.term.evaluate())
+        return self.term.source.mortar_traction(state or self.term.evaluate())
 
     def normal_force(self, state: Optional[ContactState] = None) -> float:
         """``∫ p dA = Σ_A W_A p_A`` over all ranks (a scalar)."""
         n = self.term.slave.layout.num_owned
         state = state or self.term.evaluate()
         p = self.nodal_pressures(state)
-        return float(self.term.mesh.comm.allreduce(float(np.sum((state.lumped_weights * p)[:n]))))
+        return float(self.term.comm.allreduce(float(np.sum((state.lumped_weights * p)[:n]))))
 
     def contact_force(self, state: Optional[ContactState] = None) -> FloatArray:
         """The resultant of the contact traction on the slave body, a gdim-vector:
@@ -161,12 +161,12 @@ class ContactResults:
         nodes = np.unique(self.term.slave.cells)
         nodes = nodes[nodes < self.term.slave.layout.num_owned]
         local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
-        return np.asarray(self.term.mesh.comm.allreduce(local))
+        return np.asarray(self.term.comm.allreduce(local))
 
     def active_nodes(self, state: Optional[ContactState] = None) -> int:
         """The number of slave nodes with a positive pressure, over all ranks."""
         p = self.nodal_pressures(state)
-        return int(self.term.mesh.comm.allreduce(
+        return int(self.term.comm.allreduce(
             int(np.sum(p[: self.term.slave.layout.num_owned] > 0))))
 
     # -- friction -----------------------------------------------------------------------
@@ -247,7 +247,7 @@ class ContactResults:
                                       "the pointwise one has no potential")
         n = self.term.slave.layout.num_owned
         normal = np.sum(self.term.options.law.potential(state.weights, state.gaps)[:n])
-        energy = float(self.term.mesh.comm.allreduce(float(normal)))
+        energy = float(self.term.comm.allreduce(float(normal)))
         if self.term.friction is not None:
             energy += self.term.friction.stored_energy(state.friction)
         return energy
@@ -262,7 +262,7 @@ class ContactResults:
         state = state or self.term.evaluate()
         n = self.term.slave.layout.num_owned
         states = self.slip_states(state)[:n]
-        comm = self.term.mesh.comm
+        comm = self.term.comm
         history = self.term.friction.history
         return {"tangential_force": self.tangential_force(state).tolist(),
                 "dissipation": history.dissipation,
@@ -293,7 +293,7 @@ class ContactResults:
         worst = int(np.argmax(ratio)) if n else -1
         local = ((float(ratio[worst]), float(depth[worst]), slave.x[worst].tolist())
                  if n else (-np.inf, 0.0, []))
-        return max(self.term.mesh.comm.allgather(local), key=lambda item: item[0])
+        return max(self.term.comm.allgather(local), key=lambda item: item[0])
 
     def penetration(self, state: Optional[ContactState] = None) -> tuple[float, float, list]:
         """The deepest penetration at convergence over every rank: (in slave
@@ -324,11 +324,11 @@ class ContactResults:
         normals = normals / np.where(size > 0, size, 1.0)[:, None]
         relative = u_nodes - other
         tangential = relative - np.einsum("ak,ak->a", relative, normals)[:, None] * normals
-        active = (self.term.model.nodal_pressures(state) > 0)
+        active = (self.term.source.nodal_pressures(state) > 0)
         ratio = np.where(active, np.linalg.norm(tangential, axis=1)
                          / np.maximum(self.node_lengths(), np.finfo(float).tiny), 0.0)
         n = slave.layout.num_owned
-        return float(self.term.mesh.comm.allreduce(float(np.max(ratio[:n], initial=0.0)),
+        return float(self.term.comm.allreduce(float(np.max(ratio[:n], initial=0.0)),
                                                op=MPI.MAX))
 
     def _partner_displacement(self, u_nodes: FloatArray) -> FloatArray:
@@ -337,7 +337,7 @@ class ContactResults:
         (master nodes may live on other ranks: fetched by global index)."""
         if self.term.obstacle is not None:
             return np.broadcast_to(self.term.obstacle.displacement, u_nodes.shape)
-        coupling = self.term.model.coupling
+        coupling = self.term.source.coupling
         gdim = self.term.slave.gdim
         pairs = coupling.pairs
         nodes = coupling.master_global_ids[coupling.master_cells[pairs[:, 1]]]

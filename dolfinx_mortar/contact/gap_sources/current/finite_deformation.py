@@ -32,7 +32,7 @@ master. GLS/GLS* (L depends on u through every facet) are not covered.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 import basix
 import numpy as np
@@ -42,7 +42,8 @@ from petsc4py import PETSc
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.contact.gap_sources.frozen import GapSourceBase
 from dolfinx_mortar.contact.laws import PenaltyLaw, positive_part, safe_weights
-from dolfinx_mortar.contact.gap_sources.source import ContactState
+from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
+from dolfinx_mortar.contact.gap_sources.source import ContactState, GapSource
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, is_global, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
@@ -132,6 +133,18 @@ class CurrentSurfaceGap(GapSourceBase):
     quadrature_degree
         Degree of the rule for W on every slave facet (default 2p + 2).
     """
+
+    #: friction measures each step's slip on the source frozen where it starts
+    slip_operator_per_step = True
+    #: makes that source from a nodal displacement and the same as a vector
+    #: (set where the source is chosen: :func:`~dolfinx_mortar.contact.gap_sources.choice.current_model`)
+    frozen_at: Optional[Callable[[FloatArray, PETSc.Vec], GapSource]] = None
+
+    def slip_operator(self, start: StepStart, project: bool = True) -> SlipOperator:
+        """The slip operator of the source frozen where the step starts: Δy_T
+        stays linear within a step, and a rotation within one step is seen as
+        slip to first order in the step's rotation (docs/FRICTION.md)."""
+        return self.frozen_at(start.u_nodes, start.u.copy()).slip_operator(start, project)
 
     def __init__(self, slave: LagrangeSurface, kind: BasisKind, law: PenaltyLaw,
                  quadrature_degree=None):
