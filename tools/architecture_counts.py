@@ -1,101 +1,497 @@
 """Counts that say how the contact package is laid out (docs/DESIGN.md, §Architecture).
 
-    /usr/bin/python3 tools/architecture_counts.py [--markdown]
+    /usr/bin/python3 tools/architecture_counts.py [--root TREE] [--compare OLD_TREE] [--markdown]
 
-Each count is of the source as it is, by a rule written here, so that a refactoring can be
-judged by the same rule before and after:
+Each count is of the source as it is, by a rule written here, so that a refactoring is judged by
+the same rule before and after: ``--compare OLD`` counts OLD (before) and ``--root`` (after,
+default this checkout) in one run. Paths are those of the layout by concept
+(``contact/gap_sources/`` …); in a tree with the flat ``contact/`` each is read as its old name
+(``OLD_PATHS``, the renames of commit 4c00b53), and an owner in neither is named in the output,
+not skipped silently. Only ``ast`` and regular expressions, no import of the package: the system
+python3 runs it. The package only (not tests/, demos/). Plain output: each count, before -> after,
+then every place of the tree counted after; ``--markdown``: a table, four places a cell.
 
-- modules over 400 lines (Python and C++) and Python classes over 200 lines;
-- reads of ``basis_configuration ==``/``!=`` and of ``.augmented`` outside the modules that
-  own those choices (the configuration and the Newton entry);
-- places that write the penalty law: a positive part ``np.maximum(·, 0.0)`` of a gap, or the
-  penalty multiplied into a force, in ``contact/`` outside the law's own module;
-- lines with ``einsum`` in the current configuration's Python (derivatives written by hand);
-- string-key lookups of what the C++ kernels return (``r["gradient"]``, ``pts["gap"]`` …).
+- Modules over 400 lines (Python and C++); Python classes over 200 and over 250 lines; the
+  package's own modules over 400 lines.
+- ``basis_configuration ==``/``!=`` and ``.augmented`` (not the module path
+  ``contact.newton.augmented``) outside their owners (``OWNERS``); lines
+  writing the penalty law (``np.maximum(·, 0.0)`` of a gap, the penalty times a force) in
+  ``contact/`` outside ``LAW``; ``einsum`` lines in ``CURRENT``; string-key lookups of what the
+  kernels return (``r["gradient"]``).
+- Gap-source members read but not declared: the members of the gap-source Protocol (the class
+  ``GapSource`` or ``GapModel`` in ``contact/``: its methods and class-level names) against the
+  distinct attribute names read on a gap-source object outside the gap-source modules
+  (``contact/gap_sources/**``; in the flat tree the files that moved there). A heuristic by name:
+  a gap-source object is an expression written as one of ``GAP_SOURCE_EXPRESSIONS`` (``model``,
+  ``source``, ``inner``, ``self.model``, ``term.model`` …) or a parameter annotated with the
+  Protocol's name; ``getattr``/``hasattr`` on one with a literal name is a read of that name. A
+  gap source under another name is missed, and another object so named is taken
+  (``NOT_GAP_SOURCES``: modules whose ``model`` is gmsh's are skipped).
+- isinstance on gap-source types: ``isinstance``/``issubclass`` with a class defined in a gap-source
+  module, and ``getattr``/``hasattr`` on a gap-source object (as above), anywhere in the package.
+- Branches on the active set's variant: ``.pointwise`` read in the test of an ``if``, ``while``,
+  conditional expression, ``assert`` or comprehension filter, or as an operand of ``and``/``or``/
+  ``not``, outside ``VARIANT_OWNERS`` (those that exist are named). A value passed on
+  (``keep_points=law.pointwise``) or stored is not a branch.
+- Public names of ``PUBLIC_CLASSES``: names without a leading ``_`` that are methods, properties,
+  nested classes, class-level assignments or ``self.X = …`` targets anywhere in the class.
+- Import cycles: strongly connected components of the graph of the package's modules. A package's
+  module is its ``__init__.py``; ``from a.b import c`` is an edge to ``a.b.c`` if that is a
+  module, else to ``a.b``; relative imports are resolved; the parent packages Python runs first
+  are not edges, nor ``import_module`` strings, nor the compiled ``EXTENSIONS``. Three graphs:
+  module-level imports; with those under ``if TYPE_CHECKING:``; with function-local ones too.
+  Each component is shown with one shortest cycle through its first module, its edges marked
+  ``[type-hint]``/``[function-local]`` where they are not module-level.
+- Folders of the package: the lines and number of the ``.py`` files directly in each (its
+  subfolders not included, ``__init__.py`` included), flagged over 1,500 lines or 10 modules.
+- Imports that reach past a ``contact/`` subpackage's ``__init__`` (to a module or subfolder of
+  it) from a module outside that subpackage, all three kinds of import (– in the flat tree).
+- Kind questions: calls or property reads of ``kinds.py``'s public functions but ``parse_kind``
+  (``is_global``, ``is_partition_of_unity``, ``unstarred_partner``, ``kind_name``), reads of its
+  ``*_KINDS`` sets, and comparisons (``in``, ``==``, ``is`` and negations; one per comparison) of a
+  ``BasisKind.X`` or of an expression whose name ends in ``kind``, outside ``KIND_OWNERS``
+  (``kinds.py`` and the layers that implement the kinds: ``bases/``, ``mortar/``).
 """
 from __future__ import annotations
 
 import argparse
 import ast
 import re
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Optional
 
-ROOT = Path(__file__).resolve().parents[1]
-PACKAGE = ROOT / "dolfinx_mortar"
-KERNELS = ROOT / "kernels"
+HERE = Path(__file__).resolve().parents[1]
 #: modules allowed to ask which configuration or Newton entry a term has
-OWNERS = {"contact/gap_sources/configuration.py", "contact/newton/entry.py", "contact/options.py"}
+OWNERS = ("contact/gap_sources/configuration.py", "contact/newton/entry.py", "contact/options.py")
 #: the penalty law's own module
 LAW = "contact/laws/penalty.py"
 #: the current configuration's Python
-CURRENT = ("contact/gap_sources/current/finite_deformation.py", "contact/gap_sources/current/obstacle.py",
-           "contact/gap_sources/current/mortar.py")
+CURRENT = ("contact/gap_sources/current/finite_deformation.py",
+           "contact/gap_sources/current/obstacle.py", "contact/gap_sources/current/mortar.py")
 #: keys of the dictionaries the kernels' bindings return
 KERNEL_KEYS = ("value", "gradient", "hessian", "nodes", "value_plus", "gradient_plus", "gap",
                "normals", "weights", "pairs", "slave_N", "master_N", "D", "M", "g")
 POSITIVE_PART = re.compile(r"np\.maximum\((?!.*(length|count|tiny|x\[))[^,]+,\s*0\.0\)")
 PENALTY_FORCE = re.compile(r"\b(penalty|eps) \*(?! ratio)")
+GAP_SOURCES = "contact/gap_sources/"
+PROTOCOL_NAMES = ("GapSource", "GapModel")
+GAP_SOURCE_EXPRESSIONS = {"model", "source", "inner", "self.model", "self._model", "self.source",
+                          "self._source", "self.inner", "term.model", "self.term.model",
+                          "model.inner"}
+NOT_GAP_SOURCES = {"io/gmsh_io.py"}
+#: the modules that may branch on the active set's variant (pointwise or nodal)
+VARIANT_OWNERS = ("contact/laws/penalty.py", "contact/laws/active_set.py")
+PUBLIC_CLASSES = {"ContactTerm": "contact/term.py",
+                  "NonlinearContactProblem": "solver/nonlinear_problem.py",
+                  "LoadPathSolver": "solver/load_path.py"}
+KIND_OWNERS = ("kinds.py", "bases/", "mortar/")
+EXTENSIONS = {"dolfinx_mortar._kernels"}
+IMPORT_KINDS = ("module-level", "type-hint", "function-local")
+FOLDER_LINES, FOLDER_MODULES = 1500, 10
+#: path in the layout by concept: path in the flat contact/ (ea0a892), both under contact/
+OLD_PATHS = {f"contact/{new}": f"contact/{old}" for new, old in (pair.split(":") for pair in """
+    checks/range_checks.py:checks.py checks/setup_checks.py:setup_checks.py
+    friction/state.py:friction_state.py friction/tangential.py:friction.py
+    gap_sources/choice.py:models.py gap_sources/configuration.py:configuration.py
+    gap_sources/current/finite_deformation.py:finite_deformation.py
+    gap_sources/current/mortar.py:current_mortar.py
+    gap_sources/current/obstacle.py:current_obstacle.py
+    gap_sources/cut_quadrature.py:cut_quadrature.py gap_sources/frozen.py:gaps.py
+    gap_sources/global_gap.py:global_gap.py gap_sources/pointwise.py:pointwise.py
+    gap_sources/source.py:state.py laws/coulomb.py:friction_law.py laws/penalty.py:penalty_law.py
+    newton/augmented.py:augmented.py newton/entry.py:newton_entry.py
+    newton/near_contact.py:active_set.py obstacles/analytic.py:obstacles.py
+    results/contact_results.py:results.py""".split())}
 
 
-def python_files() -> list[Path]:
-    return sorted(p for p in PACKAGE.rglob("*.py") if "__pycache__" not in p.parts)
+@dataclass
+class Count:
+    """A number (None: nothing to count by this rule in this tree), its places and a note."""
+    value: Optional[int]
+    items: list[str] = field(default_factory=list)
+    note: str = ""
+
+    def shown(self) -> str:
+        number = "–" if self.value is None else str(self.value)
+        return number + (f" ({self.note})" if self.note else "")
 
 
-def relative(path: Path) -> str:
-    return path.relative_to(PACKAGE).as_posix()
+def module_name(rel: str) -> str:
+    parts = rel[:-3].split("/")
+    return ".".join(["dolfinx_mortar", *(parts[:-1] if parts[-1] == "__init__" else parts)])
 
 
-def code_lines(path: Path) -> list[str]:
-    """The lines of a Python file without comments and docstring-only lines."""
-    out = []
-    for line in path.read_text().splitlines():
-        stripped = line.split("#", 1)[0]
-        out.append(stripped)
+def short(module: str) -> str:
+    return module.removeprefix("dolfinx_mortar.")
+
+
+def name_of(node: ast.AST) -> Optional[str]:
+    """The name a Name or an Attribute ends in."""
+    return getattr(node, "id", getattr(node, "attr", None))
+
+
+def order(place: str) -> list[tuple[int, str]]:
+    """A sort key of ``file:line …``: by file, then by line number."""
+    return [(int(p), "") if p.isdigit() else (-1, p) for p in re.split(r"[: ]", place)]
+
+
+def places(found: dict[str, list[str]]) -> list[str]:
+    """``key (where, …)`` for each key, its places in file and line order, once each."""
+    return [f"{key} ({', '.join(sorted(set(where), key=order))})"
+            for key, where in sorted(found.items())]
+
+
+class Tree:
+    """The package of one checkout, parsed once."""
+
+    def __init__(self, root: Path):
+        self.root = Path(root).resolve()
+        self.package = self.root / "dolfinx_mortar"
+        if not self.package.is_dir():
+            raise SystemExit(f"{root}: no dolfinx_mortar/ package there")
+        self.paths = {p.relative_to(self.package).as_posix(): p for p in
+                      sorted(self.package.rglob("*.py")) if "__pycache__" not in p.parts}
+        self.text = {rel: p.read_text() for rel, p in self.paths.items()}
+        self.ast = {rel: ast.parse(text) for rel, text in self.text.items()}
+        self.new_layout = (self.package / GAP_SOURCES).is_dir()
+        self.modules = {module_name(rel): rel for rel in self.paths}
+
+    def where(self, rel: str) -> Optional[str]:
+        """A path of the layout by concept as this tree has it (None: not in this tree)."""
+        old = None if self.new_layout else OLD_PATHS.get(rel)
+        return rel if rel in self.paths else (old if old in self.paths else None)
+
+    def owned(self, rels) -> tuple[set[str], str]:
+        """The owners that this tree has, and a note naming those it has not."""
+        missing = [r for r in rels if self.where(r) is None]
+        return {self.where(r) for r in rels} - {None}, (
+            f"not in this tree: {', '.join(missing)}" if missing else "")
+
+    def in_gap_sources(self, rel: str) -> bool:
+        return rel.startswith(GAP_SOURCES) if self.new_layout else rel in {
+            old for new, old in OLD_PATHS.items() if new.startswith(GAP_SOURCES)}
+
+
+def existing_counts(tree: Tree) -> dict[str, Count]:
+    """The counts of the first refactoring (docs/CONTACT_AXES.md), by the same rules."""
+    long = {"modules over 400 lines": [], "classes over 200 lines": [],
+            "classes over 250 lines": [], "package modules over 400 lines": []}
+    for path in list(tree.paths.values()) + sorted((tree.root / "kernels").rglob("*.[ch]*")):
+        n = len(path.read_text().splitlines())
+        if n > 400 and path.suffix in (".py", ".h", ".cpp"):
+            long["modules over 400 lines"].append(f"{path.relative_to(tree.root).as_posix()} ({n})")
+            if path.suffix == ".py":
+                long["package modules over 400 lines"].append(
+                    f"{path.relative_to(tree.package).as_posix()} ({n})")
+    (owners, owners_note), (law, law_note) = tree.owned(OWNERS), tree.owned([LAW])
+    current, current_note = tree.owned(CURRENT)
+    key_pattern = re.compile(r"\w+\[\"(" + "|".join(KERNEL_KEYS) + r")\"\]")
+    # (row, note, which modules the rule reads, what a line counts)
+    rules = (("basis_configuration ==/!= outside its owner", owners_note, lambda m: m not in owners,
+              lambda s: bool(re.search(r"basis_configuration\s*[!=]=", s))),
+             # not the module's own path (contact.newton.augmented, as contact.augmented was)
+             (".augmented reads outside its owner", owners_note, lambda m: m not in owners,
+              lambda s: bool(re.search(r"(?<!contact)(?<!newton)\.augmented\b", s))),
+             ("places the penalty law is written (contact/, outside its module)", law_note,
+              lambda m: m.startswith("contact/") and m not in law,
+              lambda s: bool(POSITIVE_PART.search(s) or PENALTY_FORCE.search(s))),
+             ("einsum lines in the current configuration's Python", current_note,
+              lambda m: m in current, lambda s: "einsum" in s),
+             ("string-key lookups of kernel results", "", lambda m: True,
+              lambda s: len(key_pattern.findall(s))))
+    rows = {row: Count(0, note=note) for row, note, _, _ in rules}
+    for name, module in tree.ast.items():
+        for node in ast.walk(module):
+            n = node.end_lineno - node.lineno + 1 if isinstance(node, ast.ClassDef) else 0
+            for limit in (200, 250):
+                if n > limit:
+                    long[f"classes over {limit} lines"].append(f"{name}:{node.name} ({n})")
+        lines = [line.split("#", 1)[0] for line in tree.text[name].splitlines()]
+        for row, _, reads, counted in rules:
+            rows[row].value += sum(map(counted, lines)) if reads(name) else 0
+    return {key: Count(len(items), items) for key, items in long.items()} | rows
+
+
+def protocol(tree: Tree) -> tuple[Optional[str], set[str]]:
+    """The gap-source Protocol's name and its declared members."""
+    for rel, module in tree.ast.items():
+        for node in ast.walk(module) if rel.startswith("contact/") else ():
+            if isinstance(node, ast.ClassDef) and node.name in PROTOCOL_NAMES:
+                return node.name, class_level_names(node)
+    return None, set()
+
+
+def class_level_names(node: ast.ClassDef) -> set[str]:
+    """The methods, nested classes and assigned names of a class body."""
+    names = set()
+    for item in node.body:
+        if isinstance(item, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.add(item.name)
+        targets = [item.target] if isinstance(item, ast.AnnAssign) else getattr(item, "targets", [])
+        names |= {n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)}
+    return names
+
+
+def gap_source_objects(module: ast.Module, protocol_name: Optional[str]) -> set[int]:
+    """The ids of the expressions that the rule takes for a gap source."""
+    objects = {id(node) for node in ast.walk(module) if isinstance(node, (ast.Name, ast.Attribute))
+               and ast.unparse(node) in GAP_SOURCE_EXPRESSIONS}
+    for node in ast.walk(module) if protocol_name else ():
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            a = node.args
+            typed = {p.arg for p in a.posonlyargs + a.args + a.kwonlyargs if p.annotation
+                     and re.search(rf"\b{protocol_name}\b", ast.unparse(p.annotation))}
+            objects |= {id(n) for n in ast.walk(node) if isinstance(n, ast.Name) and n.id in typed}
+    return objects
+
+
+def gap_source_counts(tree: Tree) -> dict[str, Count]:
+    name, declared = protocol(tree)
+    classes = {node.name for rel, module in tree.ast.items() if tree.in_gap_sources(rel)
+               for node in ast.walk(module) if isinstance(node, ast.ClassDef)}
+    undeclared: dict[str, list[str]] = {}
+    asked = []
+    for rel, module in tree.ast.items():
+        objects = set() if rel in NOT_GAP_SOURCES else gap_source_objects(module, name)
+        for node in ast.walk(module):
+            read = (node.attr if isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Load)
+                    and id(node.value) in objects else None)
+            call = name_of(node.func) if isinstance(node, ast.Call) else None
+            if call in ("getattr", "hasattr") and node.args and id(node.args[0]) in objects:
+                key = node.args[1] if len(node.args) > 1 else None
+                read = key.value if isinstance(getattr(key, "value", None), str) else "?"
+                asked.append(f"{rel}:{node.lineno} {call}(…, {read!r})")
+            if call in ("isinstance", "issubclass") and len(node.args) == 2:
+                types = getattr(node.args[1], "elts", [node.args[1]])
+                if hits := [ast.unparse(t) for t in types if name_of(t) in classes]:
+                    asked.append(f"{rel}:{node.lineno} {call}(…, {', '.join(hits)})")
+            if read and not tree.in_gap_sources(rel) and read not in declared \
+                    and not read.startswith("__"):
+                undeclared.setdefault(read, []).append(f"{rel}:{node.lineno}")
+    return {"gap-source members read but not declared (distinct names)": Count(
+                len(undeclared) if name else None, places(undeclared),
+                "" if name else f"no {' or '.join(PROTOCOL_NAMES)} in contact/"),
+            "isinstance/getattr on gap-source types": Count(len(asked), sorted(asked, key=order))}
+
+
+def variant_branches(tree: Tree) -> dict[str, Count]:
+    owners, _ = tree.owned(VARIANT_OWNERS)
+    found: dict[str, list[str]] = {}
+    for rel, module in tree.ast.items():
+        tests = []
+        for node in ast.walk(module) if rel not in owners else ():
+            if isinstance(node, (ast.If, ast.While, ast.IfExp, ast.Assert)):
+                tests.append(node.test)
+            tests += getattr(node, "ifs", []) + getattr(node, "values", []) if isinstance(
+                node, (ast.comprehension, ast.BoolOp)) else []
+            if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
+                tests.append(node.operand)
+        reads = sorted({(n.lineno, n.col_offset) for t in tests for n in ast.walk(t)
+                        if isinstance(n, ast.Attribute) and n.attr == "pointwise"
+                        and isinstance(n.ctx, ast.Load)})
+        if reads:
+            found[rel] = [str(line) for line, _ in reads]
+    owner = f"owner {', '.join(sorted(owners))}" if owners else "no owner in this tree"
+    return {"branches on .pointwise outside the variant's owner": Count(
+        sum(map(len, found.values())), places(found), f"{len(found)} modules; {owner}")}
+
+
+def public_names(tree: Tree) -> dict[str, Count]:
+    out = {}
+    for cls, rel in PUBLIC_CLASSES.items():
+        where = tree.where(rel)
+        node = next((n for n in ast.walk(tree.ast[where]) if isinstance(n, ast.ClassDef)
+                     and n.name == cls), None) if where else None
+        names = class_level_names(node) | {
+            n.attr for n in ast.walk(node) if isinstance(n, ast.Attribute) and isinstance(
+                n.ctx, ast.Store) and name_of(n.value) == "self"} if node else set()
+        public = sorted(n for n in names if not n.startswith("_"))
+        out[f"public names of {cls}"] = Count(len(public), public) if node else Count(
+            None, note=f"no {cls} in {rel}")
     return out
 
 
-def counts() -> dict[str, object]:
-    long_modules = []
-    for path in python_files() + sorted(KERNELS.rglob("*.[ch]*")):
-        n = len(path.read_text().splitlines())
-        if n > 400 and path.suffix in (".py", ".h", ".cpp"):
-            long_modules.append(f"{path.relative_to(ROOT).as_posix()} ({n})")
-    long_classes = []
-    configuration_reads = augmented_reads = law_places = einsum_lines = key_lookups = 0
-    key_pattern = re.compile(r"\w+\[\"(" + "|".join(KERNEL_KEYS) + r")\"\]")
-    for path in python_files():
-        name = relative(path)
-        tree = ast.parse(path.read_text())
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ClassDef) and node.end_lineno - node.lineno + 1 > 200:
-                long_classes.append(f"{name}:{node.name} ({node.end_lineno - node.lineno + 1})")
-        lines = code_lines(path)
-        if name not in OWNERS:
-            configuration_reads += sum(bool(re.search(r"basis_configuration\s*[!=]=", s))
-                                       for s in lines)
-            augmented_reads += sum(bool(re.search(r"(?<!contact)\.augmented\b", s)) for s in lines)
-        if name.startswith("contact/") and name != LAW:
-            law_places += sum(bool(POSITIVE_PART.search(s) or PENALTY_FORCE.search(s))
-                              for s in lines)
-        if name in CURRENT:
-            einsum_lines += sum("einsum" in s for s in lines)
-        key_lookups += sum(len(key_pattern.findall(s)) for s in lines)
-    return {"modules over 400 lines": long_modules,
-            "classes over 200 lines": long_classes,
-            "basis_configuration ==/!= outside its owner": configuration_reads,
-            ".augmented reads outside its owner": augmented_reads,
-            "places the penalty law is written (contact/, outside its module)": law_places,
-            "einsum lines in the current configuration's Python": einsum_lines,
-            "string-key lookups of kernel results": key_lookups}
+def imports(tree: Tree) -> list[tuple[str, str, int, int]]:
+    """(importer, imported module, kind: index in IMPORT_KINDS, line) of each package import."""
+    known = set(tree.modules) | EXTENSIONS
+    out = set()
+    for rel, module in tree.ast.items():
+        name = module_name(rel)
+        package = name if rel.endswith("__init__.py") else name.rpartition(".")[0]
+
+        def visit(node: ast.AST, kind: int) -> None:
+            if isinstance(node, ast.Import):
+                for alias in node.names:
+                    parts = alias.name.split(".")
+                    out.update((name, m, kind, node.lineno) for m in next((
+                        [".".join(parts[:n])] for n in range(len(parts), 0, -1)
+                        if ".".join(parts[:n]) in known), []))
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    parts = package.split(".")[:len(package.split(".")) - node.level + 1]
+                    base = ".".join(parts + [node.module] * bool(node.module))
+                for alias in node.names:
+                    target = f"{base}.{alias.name}" if f"{base}.{alias.name}" in known else base
+                    out.update([(name, target, kind, node.lineno)] if target in known else [])
+            elif isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+                for child in node.body:
+                    visit(child, max(kind, 1))
+                for child in node.orelse:
+                    visit(child, kind)
+            else:
+                function = isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+                for child in ast.iter_child_nodes(node):
+                    visit(child, 2 if function else kind)
+        visit(module, 0)
+    return sorted(edge for edge in out if edge[1] in tree.modules and edge[1] != edge[0])
+
+
+def components(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module: each module with those that
+    reach it among those it reaches (a search from each module; the package has ~100)."""
+    reach = {}
+    for v in graph:
+        seen, todo = set(), [v]
+        while todo:
+            todo.extend(graph.get(w := todo.pop(), set()) - seen)
+            seen.add(w)
+        reach[v] = seen
+    parts = {frozenset(w for w in reach[v] if v in reach.get(w, ())) | {v} for v in graph}
+    return sorted(sorted(part) for part in parts if len(part) > 1)
+
+
+def shortest_cycle(part: list[str], graph: dict[str, set[str]]) -> list[str]:
+    """A shortest cycle through the component's first module (a breadth-first search)."""
+    start, before = part[0], {part[0]: ""}
+    queue = [start]
+    for v in queue:
+        for w in sorted(graph[v] & set(part)):
+            if w == start:
+                path = [v]
+                while path[-1] != start:
+                    path.append(before[path[-1]])
+                return path[::-1] + [start]
+            if w not in before:
+                before[w] = v
+                queue.append(w)
+    return part
+
+
+def import_counts(tree: Tree) -> dict[str, Count]:
+    edges = imports(tree)
+    kind_of: dict[tuple[str, str], int] = {}
+    for a, b, kind, _ in edges:
+        kind_of[(a, b)] = min(kind, kind_of.get((a, b), kind))
+    out = {}
+    for level, label in enumerate(("module-level imports", "with type-hint imports",
+                                   "with type-hint and function-local imports")):
+        graph: dict[str, set[str]] = {}
+        for (a, b), kind in kind_of.items():
+            if kind <= level:
+                graph.setdefault(a, set()).add(b)
+        items = []
+        for part in components(graph):
+            path = shortest_cycle(part, graph)
+            marks = [" → " + (f"[{IMPORT_KINDS[kind_of[a, b]]}] " if kind_of[a, b] else "")
+                     + short(b) for a, b in zip(path, path[1:])]
+            rest = [short(m) for m in part if m not in path]
+            items.append(f"{len(part)} modules: {short(path[0])}{''.join(marks)}"
+                         + (f" (and {', '.join(rest)})" if rest else ""))
+        out[f"import cycles, {label}"] = Count(len(items), items)
+    subpackages = {rel.split("/")[1] for rel in tree.paths
+                   if re.fullmatch(r"contact/\w+/__init__\.py", rel)}
+    deep = sorted({f"{tree.modules[a]}:{line} {short(b)}" for a, b, _, line in edges
+                   for sub in subpackages if b.startswith(f"dolfinx_mortar.contact.{sub}.")
+                   and not a.startswith(f"dolfinx_mortar.contact.{sub}")})
+    out["imports past a contact subpackage's __init__"] = Count(
+        len(deep) if subpackages else None, deep,
+        "" if subpackages else "no subpackages of contact/")
+    return out
+
+
+def folder_counts(tree: Tree) -> dict[str, Count]:
+    sizes: dict[str, list[int]] = {}
+    for rel, text in tree.text.items():
+        folder = f"dolfinx_mortar/{rel.rpartition('/')[0]}/".replace("//", "/")
+        size = sizes.setdefault(folder, [0, 0])
+        size[0] += len(text.splitlines())
+        size[1] += 1
+    flagged = [f"{folder} ({lines} lines, {n} modules)" for folder, (lines, n)
+               in sorted(sizes.items()) if lines > FOLDER_LINES or n > FOLDER_MODULES]
+    return {f"folders over {FOLDER_LINES:,} lines or {FOLDER_MODULES} modules":
+            Count(len(flagged), flagged)}
+
+
+def kind_questions(tree: Tree) -> dict[str, Count]:
+    kinds = tree.ast.get("kinds.py")
+    if kinds is None:
+        return {"kind questions outside the kinds' owners": Count(None, note="no kinds.py")}
+    predicates = {n.name for n in kinds.body if isinstance(n, ast.FunctionDef)
+                  and not n.name.startswith("_")} - {"parse_kind"}
+    sets = {t.id for n in kinds.body for t in getattr(n, "targets", [getattr(n, "target", None)])
+            if isinstance(t, ast.Name) and t.id.endswith("_KINDS")}
+    comparisons = (ast.In, ast.NotIn, ast.Eq, ast.NotEq, ast.Is, ast.IsNot)
+
+    def kind_like(e: ast.AST) -> bool:
+        return (name_of(e) or "").endswith("kind") or getattr(e, "id", None) in sets or (
+            isinstance(e, ast.Attribute) and name_of(e.value) == "BasisKind")
+
+    found: dict[str, list[str]] = {}
+    for rel, module in tree.ast.items():
+        asked, seen = [], set()
+        owner = any(rel == o or (o.endswith("/") and rel.startswith(o)) for o in KIND_OWNERS)
+        for node in ast.walk(module) if not owner else ():
+            if isinstance(node, ast.Compare) and all(isinstance(o, comparisons) for o in node.ops) \
+                    and any(map(kind_like, [node.left, *node.comparators])):
+                asked.append((node.lineno, ast.unparse(node)[:40]))
+                seen |= {id(n) for n in ast.walk(node)}
+            elif isinstance(node, ast.Call) and name_of(node.func) in predicates \
+                    and id(node) not in seen:
+                asked.append((node.lineno, f"{name_of(node.func)}()"))
+                seen.add(id(node.func))
+            elif id(node) not in seen and (getattr(node, "id", None) in sets or (
+                    isinstance(node, ast.Attribute) and node.attr in predicates)):
+                asked.append((node.lineno, name_of(node)))
+        if asked:
+            found[rel] = [f"{line} {what}" for line, what in sorted(asked)]
+    return {"kind questions outside the kinds' owners": Count(
+        sum(map(len, found.values())), places(found), f"{len(found)} modules")}
+
+
+def counts(root: Path = HERE) -> dict[str, Count]:
+    tree = Tree(root)
+    out = existing_counts(tree)
+    for rule in (gap_source_counts, variant_branches, public_names, import_counts,
+                 folder_counts, kind_questions):
+        out |= rule(tree)
+    return out
+
+
+def cell(count: Count, limit: int = 4) -> str:
+    more = len(count.items) - limit
+    items = count.items[:limit] + [f"… {more} more"] * (more > 0)
+    return (count.shown() + (": " + "; ".join(items) if items else "")).replace("|", "\\|")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--markdown", action="store_true", help="a table row per count")
+    parser.add_argument("--root", type=Path, default=HERE, help="the checkout to count (after)")
+    parser.add_argument("--compare", type=Path, help="an older checkout (before), counted too")
+    parser.add_argument("--markdown", action="store_true", help="a markdown table")
     args = parser.parse_args()
-    for name, value in counts().items():
-        shown = (f"{len(value)}: " + ", ".join(value)) if isinstance(value, list) else value
-        print(f"| {name} | {shown} |" if args.markdown else f"{name}: {shown}")
+    after = counts(args.root)
+    before = counts(args.compare) if args.compare else None
+    if args.markdown:
+        print("| count | before | after |\n|---|---|---|" if before
+              else "| count | value |\n|---|---|")
+        for name, count in after.items():
+            print(f"| {name} | {cell(before[name]) + ' | ' if before else ''}{cell(count)} |")
+        return
+    for name, count in after.items():      # the lists: of the tree counted after
+        print(f"{name}: {before[name].shown() + ' -> ' if before else ''}{count.shown()}")
+        print("".join(f"    {item}\n" for item in count.items), end="")
 
 
 if __name__ == "__main__":
