@@ -101,7 +101,7 @@ def newton_matrix(problem):
     J = problem.problem.matrix()
     problem.problem.F(u, problem.problem.vector())
     problem.problem.J(u, J)
-    cap = problem.contact._entry.step  # the augmented system's own matrices (a diagnostic)
+    cap = problem.contact._newton.entry.step  # the augmented system's own matrices (a diagnostic)
     if cap is not None:
         if cap.G_linearized is not None and cap.G_linearized is not cap.G:
             raise NotImplementedError("condition numbers of the pointwise GLS step")
@@ -116,7 +116,7 @@ def newton_matrix(problem):
                                          shape=K.shape)).tocsr()
     else:
         A = gather_sparse(J)
-    free = gather_vector(problem.contact._mask(problem.bcs)) > 0.5
+    free = gather_vector(problem.contact._newton.mask(problem.bcs)) > 0.5
     return A, free
 
 

@@ -68,27 +68,6 @@ def _exception_like(module: str, name: str, message: str) -> BaseException:
         return RuntimeError(f"{module}.{name} on another rank: {message}")
 
 
-def checked_contact_terms(u, contact) -> list:
-    """The contact term or terms given to a
-    :class:`~dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem`
-    on ``u``, as a list, checked on every rank together (collective)."""
-    from dolfinx_mortar.contact.term import ContactTerm     # it imports this module
-    with collective_checks(communicator_of(u)):
-        contacts = [contact] if isinstance(contact, ContactTerm) else list(contact)
-        if not contacts:
-            raise ValueError("no contact term: use dolfinx.fem.petsc.NonlinearProblem")
-        for term in contacts:
-            if not isinstance(term, ContactTerm):
-                raise TypeError(f"contact terms must be ContactTerms, got "
-                                f"{type(term).__name__}")
-            if term.u is not u:
-                raise ValueError("every contact term must be built on the problem's u")
-        if len(contacts) > 1 and any(term.traits.takes_the_linear_solve for term in contacts):
-            raise NotImplementedError("a GLS kind (augmented Newton step) must be the only "
-                                      "contact term of a problem")
-    return contacts
-
-
 def load_data(forms: Sequence, u, bcs: Sequence) -> list[tuple[str, Callable]]:
     """What a load path may set in the user's model, each with a description and
     a function that returns its present local values: the Constants and the

@@ -78,10 +78,13 @@ GAP_SOURCES = "contact/gap_sources/"
 PROTOCOL_NAMES = ("GapSource", "GapModel")
 GAP_SOURCE_EXPRESSIONS = {"model", "source", "inner", "self.model", "self._model", "self.source",
                           "self._source", "self.inner", "term.model", "self.term.model",
-                          "model.inner"}
+                          "model.inner", "term.source", "self.term.source"}
 NOT_GAP_SOURCES = {"io/gmsh_io.py"}
-#: the modules that may branch on the active set's variant (pointwise or nodal)
-VARIANT_OWNERS = ("contact/laws/penalty.py", "contact/laws/active_set.py")
+#: the modules that may branch on the active set's variant (pointwise or nodal): the law
+#: that holds it, the frozen sources' one choice of their positive gaps (point_gaps_of), and
+#: the options' check of their combinations
+VARIANT_OWNERS = ("contact/laws/penalty.py", "contact/laws/active_set.py",
+                  "contact/gap_sources/pointwise.py", "contact/options.py")
 PUBLIC_CLASSES = {"ContactTerm": "contact/term.py",
                   "NonlinearContactProblem": "solver/nonlinear_problem.py",
                   "LoadPathSolver": "solver/load_path.py"}
@@ -214,12 +217,24 @@ def existing_counts(tree: Tree) -> dict[str, Count]:
 
 
 def protocol(tree: Tree) -> tuple[Optional[str], set[str]]:
-    """The gap-source Protocol's name and its declared members."""
+    """The gap-source Protocol's name and its declared members, with those of
+    the Protocols that extend it (``GlobalGapSource``: what GLS's augmented
+    step asks of its source)."""
+    found, extensions = None, []
     for rel, module in tree.ast.items():
         for node in ast.walk(module) if rel.startswith("contact/") else ():
             if isinstance(node, ast.ClassDef) and node.name in PROTOCOL_NAMES:
-                return node.name, class_level_names(node)
-    return None, set()
+                found = node
+            elif isinstance(node, ast.ClassDef):
+                extensions.append(node)
+    if found is None:
+        return None, set()
+    declared = class_level_names(found)
+    for node in extensions:
+        bases = {ast.unparse(b) for b in node.bases}
+        if found.name in bases and "Protocol" in bases:
+            declared |= class_level_names(node)
+    return found.name, declared
 
 
 def class_level_names(node: ast.ClassDef) -> set[str]:

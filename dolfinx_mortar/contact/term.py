@@ -20,7 +20,7 @@ from __future__ import annotations
 import time
 from contextlib import contextmanager
 from dataclasses import replace
-from typing import Iterator, Optional, Sequence
+from typing import ContextManager, Iterator, Optional, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -29,18 +29,15 @@ from dolfinx.fem import petsc as fem_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.checks import (RangeChecks, check_initial_overlap,
-                                           check_penalty_represents_a_force,
-                                           warn_if_the_obstacle_faces_away)
+from dolfinx_mortar.contact.checks import RangeChecks, check_penalty_represents_a_force
 from dolfinx_mortar.contact.friction import Friction
-from dolfinx_mortar.contact.gap_sources import ContactState, GapSource, configuration_of
+from dolfinx_mortar.contact.gap_sources import GapSource, configuration_of
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.contact.laws import TangentialLaw, check_tangential_law
-from dolfinx_mortar.contact.newton import (JacobianAssembly, NearContactStiffness, NewtonTraits,
-                                           entry_of, gap_closing_force)
+from dolfinx_mortar.contact.newton import JacobianAssembly, NewtonTraits, TermAssembly
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.results import ContactResults
-from dolfinx_mortar.dolfinx_compat import ghosted_vector
 from dolfinx_mortar.input_checks import (check_cells, check_contact_arguments,
                                          check_contact_tags, collective_checks,
                                          communicator_of)
@@ -66,9 +63,8 @@ class ContactTerm:
     master_tag
         Tag of the master facets in the same mesh (two bodies), or None.
     obstacle
-        A rigid analytic obstacle instead of a master surface
-        (:mod:`dolfinx_mortar.contact.obstacles.analytic`); it may be moved between
-        load steps (``obstacle.move_to``).
+        A rigid obstacle (:mod:`dolfinx_mortar.contact.obstacles`) instead of a
+        master surface; it may be moved between load steps (``obstacle.move_to``).
     kind
         Mortar basis kind, any of the six (docs/DESIGN.md, §Bases).
     penalty
@@ -80,41 +76,31 @@ class ContactTerm:
         (``p_A = ε∫M̄_A⟨d⟩``, unsymmetric exact Jacobian).
     basis_configuration
         ``"initial"`` (default): bases and segmentation in the reference
-        configuration, good up to about one element of slip;
-        ``"previous"``: rebuilt when a load step starts (:meth:`begin_step`);
-        ``"current"``: on the current surfaces at every evaluation, with the
-        exact linearization (local kinds).
+        configuration, good up to about one element of slip; ``"previous"``:
+        rebuilt when a load step starts (:meth:`begin_step`); ``"current"``: on
+        the current surfaces, exactly linearized (local kinds).
     quadratic_transform
         Transformed basis on quadratic triangle facets (always on axisymmetric
         P2 lines, see ``axisymmetric``).
     boundary_modification
         Elastic master, dual kinds: the basis rebuilt over the covered part of
-        partly covered slave facets (Popp et al. 2013). ``None`` (default):
-        on for the dual kinds against an elastic master with the nodal active
-        set in the "initial" and "previous" configurations, where it is
-        implemented. Without it, a slave facet that the master covers only
-        near its far node reads a separation as a penetration (the dual
-        functions are negative there).
+        partly covered slave facets (Popp et al. 2013; docs/DESIGN.md, §Boundary
+        modification). ``None`` (default): on where it is implemented (dual
+        kinds, elastic master, nodal set, "initial" and "previous").
     search_radius
         How far along its normal a slave facet reaches for master facets to
         pair with (default the largest slave facet diameter).
     axisymmetric
-        The mesh is the (r, z) half-plane r ≥ 0 of a body of revolution (x the
-        radius, y the axis): every contact integral carries 2πr, so that
-        forces are those on the whole body (docs/AXISYMMETRIC.md). The user's bulk form
-        must be axisymmetric too
-        (:func:`~dolfinx_mortar.small_strain.elastic.axisymmetric_elastic_residual`).
+        The mesh is the (r, z) half-plane of a body of revolution: every contact
+        integral carries 2πr, forces are the whole body's (docs/AXISYMMETRIC.md;
+        the bulk form must be axisymmetric too).
     friction
-        A friction law: Coulomb friction
-        (:class:`~dolfinx_mortar.contact.laws.CoulombFriction`: μ and the
-        tangential penalty) or any :class:`~dolfinx_mortar.contact.laws.TangentialLaw`;
-        None: frictionless (default). Its
-        history moves on in :meth:`accept_step` (docs/FRICTION.md).
+        A friction law (:class:`~dolfinx_mortar.contact.laws.CoulombFriction`, or
+        any :class:`~dolfinx_mortar.contact.laws.TangentialLaw`); None:
+        frictionless (default). Its history moves on in :meth:`accept_step`.
     name
-        The term's name, which names its output file ``<output>_<name>.xdmf``
-        (letters, digits, ``_``, ``-``). None (default): ``<output>_slave.xdmf``
-        when it is a problem's only term, ``<output>_slave<slave_tag>.xdmf``
-        among several (:mod:`dolfinx_mortar.io.contact_output`).
+        Names the term's output file ``<output>_<name>.xdmf`` (letters, digits,
+        ``_``, ``-``); None: from the slave tag (:mod:`dolfinx_mortar.io.contact_output`).
     """
 
     def __init__(self, u: fem.Function, facet_tags, slave_tag: int, *,
@@ -128,13 +114,12 @@ class ContactTerm:
         # one decision of all ranks: an argument bad on one rank only raises on every rank
         with collective_checks(communicator_of(u)):
             check_contact_arguments(u, master_tag, obstacle, axisymmetric)
+            check_tangential_law(friction)
             #: the name of the term's output (None: from the slave tag)
             self.name: Optional[str] = check_term_name(name)
-            check_tangential_law(friction)
-            options = ContactOptions.checked(kind, penalty, scaling, active_set,
-                                             basis_configuration, boundary_modification,
-                                             search_radius, master_tag is not None,
-                                             axisymmetric)
+            options = ContactOptions.checked(
+                kind, penalty, scaling, active_set, basis_configuration,
+                boundary_modification, search_radius, master_tag is not None, axisymmetric)
         V = u.function_space
         check_cells(V.mesh)
         check_contact_tags(V.mesh, facet_tags, slave_tag, master_tag)
@@ -154,26 +139,20 @@ class ContactTerm:
         #: the checked options (kind, penalty law, configuration, …)
         self.options = options
         self._configuration = configuration_of(options, self.slave, self.master, obstacle)
-        self._entry = entry_of(options.kind, self.comm, V.dofmap.index_map_bs)
+        self._newton = TermAssembly(V, options.kind, self._configuration)
         #: wall times of the contact work by part, seconds (accumulated)
         self.timings: dict[str, float] = {}
-        self._state: Optional[ContactState] = None
-        self._masks: dict = {}
         #: what the term reports (pressures, forces, slip, …)
         self.results = ContactResults(self)
         self._checks = RangeChecks(self, self._configuration)
         #: Coulomb friction and its history (None: frictionless)
         self.friction: Optional[Friction] = (None if friction is None else
                                              Friction(friction, options, u, self.slave, obstacle))
-        self._near_contact = NearContactStiffness()
         #: the gap source (:class:`~dolfinx_mortar.contact.gap_sources.GapSource`)
-        self.source: GapSource = self._timed_build(self._configuration.build, options)
-        self._checks.warn_deep_initial_penetration()
-        if obstacle is not None:
-            warn_if_the_obstacle_faces_away(obstacle, self.slave, self.comm)
-        coupling = self._configuration.segmentation(self.source)
-        check_initial_overlap(self, coupling, self._configuration.built_at_u)
-        self._checks.warn_if_no_master_is_in_reach(coupling)
+        self.source: GapSource
+        clock = time.perf_counter()
+        self._take(self._configuration.build(options, u), clock)
+        self._checks.of_a_new_term()
 
     @property
     def comm(self) -> MPI.Comm:
@@ -188,76 +167,59 @@ class ContactTerm:
     @property
     def traits(self) -> NewtonTraits:
         """What a Newton solver needs to know of this term (:class:`NewtonTraits`)."""
-        follows_u = self._configuration.follows_u
-        return NewtonTraits(
-            symmetric=not (self.options.law.pointwise or follows_u or self.friction is not None),
-            moving_pattern=self.source.moving_pattern, follows_u=follows_u,
-            takes_the_linear_solve=self._entry.takes_the_linear_solve,
-            frictional=self.friction is not None)
+        return self._newton.traits(self.options.law, self.source, self.friction is not None)
 
     @property
     def state(self) -> Optional[ContactState]:
-        """The contact state of the last :meth:`update` (None: none since the
-        gap source was made)."""
-        return self._state
+        """The contact state of the last :meth:`update` (None: none since the source was made)."""
+        return self._newton.state
 
     # -- the gap source through a load path ------------------------------------------
-    def _timed_build(self, build, options: ContactOptions) -> Optional[GapSource]:
-        """``build(options, u)``; where it makes a new source (not None), the
-        state of the old one is dropped."""
-        clock = time.perf_counter()
-        source = build(options, self.u)
-        if source is not None:
-            self._state = None
-            self._configuration.forget()
-            self.timings["setup"] = time.perf_counter() - clock
-        return source
-
-    def begin_step(self) -> bool:
-        """Called by a load-path driver when a load step starts.
-
-        With ``basis_configuration="previous"`` the bases (and segmentation)
-        are rebuilt in the configuration of the last converged step if u moved
-        since they were built; returns True then (the contact pattern may have
-        changed: :meth:`create_matrix` again).
-        """
-        self._near_contact.reset()
-        source = self._timed_build(self._configuration.begin_step, self.options)
+    def _take(self, source: Optional[GapSource], since: Optional[float] = None) -> bool:
+        """Make ``source`` the term's (None: keep the present one; ``since``: timed)."""
         if source is None:
             return False
-        self.source = source
+        self.source, self._newton.state = source, None
+        self._configuration.forget()
+        if since is not None:
+            self.timings["setup"] = time.perf_counter() - since
         return True
 
-    def rebuild(self, search_radius: float) -> None:
-        """The bases and segmentation made again with another search radius, in
-        the configuration they were built in."""
+    def begin_step(self) -> bool:
+        """Called by a load-path driver when a load step starts. With
+        ``basis_configuration="previous"`` the bases (and segmentation) are
+        rebuilt in the configuration of the last converged step if u moved
+        since; returns True then (the pattern may change: :meth:`create_matrix`)."""
+        self._newton.near_contact.reset()
+        clock = time.perf_counter()
+        return self._take(self._configuration.begin_step(self.options, self.u), clock)
+
+    def _rebuild(self, search_radius: float) -> bool:
+        """The bases made again with another search radius, in their configuration."""
         self.options = replace(self.options, search_radius=search_radius)
-        self.source = self._timed_build(self._configuration.rebuild, self.options)
+        clock = time.perf_counter()
+        return self._take(self._configuration.rebuild(self.options, self.u), clock)
 
     @contextmanager
     def frozen(self) -> Iterator[None]:
-        """With ``basis_configuration="current"``: the source frozen at the present u
-        (the "previous" one) inside the block. A load-path driver solves each
-        step with it first; other configurations are unchanged."""
-        frozen = self._configuration.frozen_model(self.options, self.u)
-        if frozen is None:
+        """With ``basis_configuration="current"``: the source frozen at the present
+        u (the "previous" one) inside the block, with which a load-path driver
+        solves each step first; other configurations are unchanged."""
+        current = self.source
+        if not self._take(self._configuration.frozen_model(self.options, self.u)):
             yield
             return
-        current, self.source = self.source, frozen
         try:
             yield
         finally:
-            self.source, self._state = current, None
-            self._configuration.forget()
+            self._take(current)
 
     def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:
-        """Called by a load-path driver after a converged step, before
-        :meth:`accept_step`: where the contact zone reached the default search
-        radius, the bases are rebuilt with a wider one and True is returned
-        (the step must be solved again, with :meth:`create_matrix` again;
-        :meth:`RangeChecks.widen_search_radius
-        <dolfinx_mortar.contact.checks.RangeChecks.widen_search_radius>`; collective)."""
-        return self._checks.widen_search_radius(state)
+        """After a converged step, before :meth:`accept_step`: True where the
+        contact zone reached the default search radius and the bases were
+        rebuilt with a wider one (solve the step again; collective)."""
+        radius = self._checks.wider_search_radius(state)
+        return radius is not None and self._rebuild(radius)
 
     def accept_step(self, state: Optional[ContactState] = None) -> None:
         """The present u is a converged load step: friction's history (the
@@ -271,94 +233,43 @@ class ContactTerm:
 
     def check_path(self, deepest: tuple[float, float, list]) -> None:
         """Called when a load path ends: warn if the penalty let the bodies
-        penetrate too deep (``deepest``: the path's deepest penetration,
-        :meth:`ContactResults.penetration
-        <dolfinx_mortar.contact.results.ContactResults.penetration>`) or a body
-        passed through a rigid obstacle (each warned once; collective)."""
+        penetrate too deep (``deepest``: the path's deepest ``results.penetration()``)
+        or a body passed through a rigid obstacle (each once; collective)."""
         self._checks.warn_if_the_penalty_is_low(deepest)
         self._checks.warn_if_the_body_passed_through()
 
-    # -- evaluation ------------------------------------------------------------------
     def evaluate(self) -> ContactState:
         """The contact state at the present u with every dof kept (results)."""
-        self.u.x.scatter_forward()
-        return self._with_friction(self.source.evaluate(self.u, None), None)
-
-    def _with_friction(self, state: ContactState, mask: Optional[PETSc.Vec]) -> ContactState:
-        """The state with friction's forces in its residual (as it is without friction)."""
-        if self.friction is None:
-            return state
-        if mask is None and self.friction.at_accepted_step(self.u):
-            # a result at a converged step: its own return mapping, not one
-            # with its forces already made history
-            friction = self.friction.history.accepted
-        else:
-            friction = self.friction.evaluate(self.source, state, self.u,
-                                              self._near_contact.mask(self.source, state), mask)
-        state.residual.axpy(1.0, friction.residual)
-        state.friction = friction
-        return state
+        return self._newton.evaluate(self.source, self.friction, self.u)
 
     def update(self, bcs: Sequence = ()) -> ContactState:
         """The contact state at the present values of u (ghosts updated here),
         with the Dirichlet columns of ``bcs`` dropped."""
         clock = time.perf_counter()
-        self.u.x.scatter_forward()
-        self._state = None
-        # petsc4py defers the destruction of a parallel PETSc object whose
-        # Python handle dies to a collective garbage_cleanup, which nothing
-        # else calls: the matrices of each evaluation piled up (ironing 3D at
-        # 2k dofs grew by 15 MB/s to over 5 GB with PETSc 3.18; a small block
-        # on 2 ranks of 3.22 by 0.5 MB per evaluation). An evaluation is
-        # collective, so every rank reaches this point together.
-        PETSc.garbage_cleanup(self.comm)
-        mask = self._mask(bcs)
-        self._state = self._with_friction(self.source.evaluate(self.u, mask), mask)
+        state = self._newton.update(self.source, self.friction, self.u, bcs)
         self._add("residual", clock)
-        return self._state
-
-    # -- PETSc assembly --------------------------------------------------------------
-    def _mask(self, bcs: Sequence[fem.DirichletBC] = ()) -> PETSc.Vec:
-        """1 on free dofs, 0 on the dofs of ``bcs`` (the contact terms skip those)."""
-        key = tuple(id(bc) for bc in bcs)
-        if key not in self._masks:
-            m = ghosted_vector(self._V.dofmap.index_map, self._V.dofmap.index_map_bs)
-            m.set(1.0)
-            fem_petsc.set_bc(m, list(bcs), alpha=0.0)
-            self._masks[key] = m
-        return self._masks[key]
+        return state
 
     def assemble_residual(self, b: PETSc.Vec, bcs: Sequence = ()) -> None:
         """``b += R_c(u)`` on the owned entries (R_c = 0 on the dofs of ``bcs``).
-
         Evaluates the contact state at u (:meth:`update`); call it before
-        :meth:`assemble_jacobian`, as Newton does.
-        """
+        :meth:`assemble_jacobian`, as Newton does."""
         b.axpy(1.0, self.update(bcs).residual)
 
     def assemble_jacobian(self, A: PETSc.Mat, bcs: Sequence = ()) -> JacobianAssembly:
-        """``A += K_c`` at the state of the last :meth:`update` (A assembled after).
-
-        GLS kinds: A is left as it is (the bulk) and the exact Newton step of
-        the augmented system is prepared instead (:meth:`configure_ksp`).
-        Returns what a solver may need of it (:class:`JacobianAssembly`).
-        """
-        if self._state is None:
+        """``A += K_c`` at the state of the last :meth:`update` (A assembled
+        after; GLS kinds: A is left as it is and the exact Newton step is
+        prepared, :meth:`configure_ksp`). Returns a :class:`JacobianAssembly`."""
+        if self._newton.state is None:
             self.update(bcs)
         clock = time.perf_counter()
-        state = self._state
-        changed = self._entry.assemble(A, self.source, state,
-                                       self._near_contact.mask(self.source, state),
-                                       self._mask(bcs), self._configuration, self.friction)
-        if self._entry.step is not None:
-            self.timings["augmented_factorization"] = self._entry.step.factorization_time
+        assembly = self._newton.jacobian(A, self.source, self.friction, bcs, self.timings)
         self._add("jacobian", clock)
-        return JacobianAssembly(changed, self._entry.stiffened_rows)
+        return assembly
 
     def configure_ksp(self, ksp: PETSc.KSP) -> None:
-        """Make ``ksp`` apply the exact Newton step (GLS kinds: the augmented
-        system, a python PC; other kinds: nothing to do)."""
-        self._entry.configure_ksp(ksp)
+        """Make ``ksp`` apply the exact Newton step (GLS: the augmented system's PC)."""
+        self._newton.entry.configure_ksp(ksp)
 
     def create_matrix(self, a: fem.Form, bcs: Sequence = ()) -> PETSc.Mat:
         """A matrix whose pattern holds the bilinear form ``a`` and the contact
@@ -366,38 +277,43 @@ class ContactTerm:
         A = fem_petsc.create_matrix(a)
         fem_petsc.assemble_matrix(A, a, list(bcs))
         A.assemble()
-        self._entry.add_pattern(A, self.source, self._state or self.update(bcs), self.friction)
-        self._configuration.new_matrix()
-        if self.source.moving_pattern or self._configuration.pattern_grows:
-            # the pairs, and so the pattern, change with u: new entries are
-            # allocated as they come
-            A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        if self._newton.state is None:
+            self.update(bcs)
+        self._newton.add_pattern(A, self.source, self.friction)
         return A
 
-    # -- before anything touches -----------------------------------------------------
     def settle_near_contact(self, free_motions) -> None:
-        """Called once per Newton Jacobian, before the contact is assembled.
-        Where nothing touches yet and some node is near contact, decide
-        whether those nodes need stiffness without force: only if one of the
-        bodies' ``free_motions`` (a callable giving the rigid motions that
-        the bulk does not resist, as dof vectors) changes their gaps
-        (:class:`~dolfinx_mortar.contact.newton.NearContactStiffness`;
-        collective)."""
-        if self._state is not None and self._near_contact.due(self.source, self._state):
-            self._near_contact.decide(self.source, self._state, free_motions())
+        """Called once per Newton Jacobian, before the contact is assembled:
+        decide whether the nodes near contact need stiffness without force
+        (``free_motions()``: the rigid motions the bulk does not resist;
+        :class:`~dolfinx_mortar.contact.newton.NearContactStiffness`; collective)."""
+        self._newton.settle(self.source, free_motions)
 
-    @contextmanager
-    def closing_gaps(self) -> Iterator[Optional[PETSc.Vec]]:
-        """The pull that closes the gaps near contact when nothing touches yet
-        (:func:`~dolfinx_mortar.contact.newton.gap_closing_force`; None when
-        something touches or nothing is near); inside the block the Jacobian
-        stiffens the nodes near contact whatever holds the body: the
-        gap-closing start's linear model."""
-        self._near_contact.closing = True
-        try:
-            yield gap_closing_force(self.source, self._state)
-        finally:
-            self._near_contact.closing = False
+    def closing_gaps(self) -> ContextManager[Optional[PETSc.Vec]]:
+        """A context giving the pull that closes the gaps near contact while
+        nothing touches (:func:`~dolfinx_mortar.contact.newton.gap_closing_force`;
+        None otherwise); inside it the Jacobian stiffens the nodes near contact."""
+        return self._newton.closing(self.source)
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
+
+
+def checked_contact_terms(u, contact) -> list:
+    """The contact term or terms given to a
+    :class:`~dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem`
+    on ``u``, as a list, checked on every rank together (collective)."""
+    with collective_checks(communicator_of(u)):
+        contacts = [contact] if isinstance(contact, ContactTerm) else list(contact)
+        if not contacts:
+            raise ValueError("no contact term: use dolfinx.fem.petsc.NonlinearProblem")
+        for term in contacts:
+            if not isinstance(term, ContactTerm):
+                raise TypeError(f"contact terms must be ContactTerms, got "
+                                f"{type(term).__name__}")
+            if term.u is not u:
+                raise ValueError("every contact term must be built on the problem's u")
+        if len(contacts) > 1 and any(term.traits.takes_the_linear_solve for term in contacts):
+            raise NotImplementedError("a GLS kind (augmented Newton step) must be the only "
+                                      "contact term of a problem")
+    return contacts

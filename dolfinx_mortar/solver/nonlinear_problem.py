@@ -31,9 +31,9 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.io.contact_output import output_names
-from dolfinx_mortar.contact.term import ContactTerm
+from dolfinx_mortar.contact.term import ContactTerm, checked_contact_terms
 from dolfinx_mortar.dolfinx_compat import ghosted_vector
-from dolfinx_mortar.input_checks import checked_contact_terms, load_data, non_finite_input
+from dolfinx_mortar.input_checks import load_data, non_finite_input
 from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
 from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
 

@@ -16,28 +16,18 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
-from dolfinx_mortar.contact.gap_sources import ContactState
+from dolfinx_mortar.contact.checks.setup_checks import (check_initial_overlap,
+                                                        warn_if_the_obstacle_faces_away)
+from dolfinx_mortar.contact.checks.thresholds import (BODY_PENETRATION, DEEP_PENETRATION,
+                                                      MAX_RADIUS_WIDENINGS, PENALTY_PENETRATION,
+                                                      SLIP_LIMIT, SUGGESTED_PENETRATION)
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import DUAL_KINDS
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
 
-#: an initial penetration deeper than this many slave element lengths is warned about
-DEEP_PENETRATION = 0.5
-#: a penetration at convergence deeper than this many slave element lengths is
-#: warned about: the penalty is low for the mesh (ε 1000× too low gave 0.055)
-PENALTY_PENETRATION = 0.01
-#: a node off the slave surface that has passed through a rigid obstacle by more
-#: than this many lengths of its cells at convergence is warned about (logged)
-BODY_PENETRATION = 0.25
-#: the penetration, in element lengths, that the suggested penalty aims at
-SUGGESTED_PENETRATION = 1e-3
-#: basis_configuration="initial" is warned about past this many element lengths of slip
-SLIP_LIMIT = 1.0
-#: how many times a default search radius is widened (×4 each) before the
-#: contact zone's reaching it is only warned about
-MAX_RADIUS_WIDENINGS = 3
 #: the checks' logger is named after the package, where users look for it
 logger = logging.getLogger("dolfinx_mortar.contact.checks")
 
@@ -102,6 +92,18 @@ class RangeChecks:
         #: times the default search radius was widened, and whether reaching it was warned
         self._radius_widenings = 0
         self._radius_warned = False
+
+    def of_a_new_term(self) -> None:
+        """The checks of a term just made: a deep initial penetration, an
+        obstacle that faces away, bodies that overlap beyond the search radius
+        (an error), no master in reach (collective)."""
+        term = self.term
+        self.warn_deep_initial_penetration()
+        if term.obstacle is not None:
+            warn_if_the_obstacle_faces_away(term.obstacle, term.slave, term.comm)
+        coupling = self.configuration.segmentation(term.source)
+        check_initial_overlap(term, coupling, self.configuration.built_at_u)
+        self.warn_if_no_master_is_in_reach(coupling)
 
     def warn_deep_initial_penetration(self) -> None:
         """Warn when the configuration penetrates by more than DEEP_PENETRATION
@@ -281,33 +283,31 @@ class RangeChecks:
         near_edge[cells[at_edge].ravel()] = True
         return bool(comm.allreduce(bool(np.any(reached & near_edge)), op=MPI.LOR))
 
-    def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:
-        """Called by a load-path driver after a converged step: where the contact
-        zone reached slave nodes that found no master within the search radius
-        though one lies beyond it
-        (:meth:`contact_reached_the_search_radius`),
-        rebuild the frozen bases with four times the radius and return True (the
-        step must be solved again, with a new matrix pattern). A radius the user
-        gave is kept, with a warning; so is one already widened
-        MAX_RADIUS_WIDENINGS times (collective)."""
+    def wider_search_radius(self, state: Optional[ContactState] = None) -> Optional[float]:
+        """After a converged step: where the contact zone reached slave nodes
+        that found no master within the search radius though one lies beyond it
+        (:meth:`contact_reached_the_search_radius`), four times the radius, for
+        the term to rebuild its bases with (the step must be solved again, with
+        a new matrix pattern); None otherwise. A radius the user gave is kept,
+        with a warning; so is one already widened MAX_RADIUS_WIDENINGS times
+        (collective)."""
         if self._radius_warned or not self.contact_reached_the_search_radius(state):
-            return False
+            return None
         term = self.term
         radius = term.source.coupling.search_radius
         widenings = self._radius_widenings
         if term.options.search_radius is None or widenings > 0:
             if widenings < MAX_RADIUS_WIDENINGS:
                 self._radius_widenings = widenings + 1
-                term.rebuild(4 * radius)
                 if term.comm.rank == 0:
                     logger.info("the contact zone reached slave nodes with no master within "
                                 "the search radius %.3g: bases rebuilt with %.3g, step "
                                 "solved again", radius, 4 * radius)
-                return True
+                return 4 * radius
         self._radius_warned = True
         warnings.warn(f"the contact zone reached slave nodes that found no master within "
                       f"the search radius {radius:.3g}, though a master lies beyond it: the "
                       f"pressure is cut off there. Pass a larger search_radius (e.g. "
                       f"{4 * radius:.3g}) or basis_configuration='previous'",
                       RuntimeWarning, stacklevel=3)
-        return False
+        return None

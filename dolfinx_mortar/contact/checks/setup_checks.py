@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_mortar.contact.checks.range_checks import DEEP_PENETRATION
+from dolfinx_mortar.contact.checks.thresholds import DEEP_PENETRATION
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.tolerance import length_scale, zero_length
@@ -53,7 +53,7 @@ def check_initial_overlap(term, coupling, built_at_u: bool) -> None:
     the surfaces are searched again with wider radii
     (:data:`OVERLAP_SEARCH_FACTORS`); where a slave node lies behind the master
     surface by more than DEEP_PENETRATION slave element lengths
-    (:mod:`~dolfinx_mortar.contact.checks.range_checks`), the bodies overlap. Two blocks
+    (:mod:`~dolfinx_mortar.contact.checks.thresholds`), the bodies overlap. Two blocks
     overlapping by two elements were reported as out of reach (collective).
     ``built_at_u``: the segmentation was made at the present u (not at u = 0).
 

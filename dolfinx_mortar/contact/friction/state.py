@@ -11,8 +11,8 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.laws import ReturnMapping
 from dolfinx_mortar.contact.options import ContactOptions
+from dolfinx_mortar.contact.state import FrictionState
 from dolfinx_mortar.layout import MassMatrixSolver
 
 FloatArray = npt.NDArray[np.float64]
@@ -20,7 +20,7 @@ FloatArray = npt.NDArray[np.float64]
 
 def check_friction_options(options: ContactOptions) -> None:
     """NotImplementedError naming a combination friction does not support, and why."""
-    if options.law.pointwise:
+    if not options.law.has_potential:
         raise NotImplementedError("friction with active_set='pointwise': the Coulomb cone is "
                                   "set by the nodal normal forces; use active_set='nodal'")
 
@@ -59,36 +59,7 @@ class FrictionHistory:
     dissipation: float = 0.0
     step_dissipation: float = 0.0
     version: int = 0
-    accepted: Optional["FrictionState"] = None
-
-
-@dataclass
-class FrictionState:
-    """Friction at one displacement (part of a
-    :class:`~dolfinx_mortar.contact.gap_sources.source.ContactState`).
-
-    Attributes
-    ----------
-    slip_increment
-        ``Δy_T`` per local node since the last accepted step, (nodes, gdim).
-    mapping
-        The return mapping's forces, derivatives and stick/slip states.
-    G_T
-        ``∂Δy_T/∂u`` (rows: node·gdim + i), Dirichlet columns dropped.
-    tangential_weights
-        ``ω_T = ε_T W^m`` per node.
-    projected_history
-        ``P_A f_T,A^n``: the last accepted forces in the present tangent planes.
-    residual
-        ``G_Tᵀ f_T``, friction's part of the contact residual.
-    """
-
-    slip_increment: FloatArray
-    mapping: ReturnMapping
-    G_T: PETSc.Mat
-    tangential_weights: FloatArray
-    projected_history: FloatArray
-    residual: Optional[PETSc.Vec] = None
+    accepted: Optional[FrictionState] = None
 
 
 @dataclass

@@ -52,7 +52,8 @@ from dolfinx_mortar.contact.laws import SLIP, ReturnMapping, TangentialLaw
 from dolfinx_mortar.contact.friction.state import (AugmentedFriction, FrictionHistory,
                                                    FrictionState, check_friction_options,
                                                    solve_components)
-from dolfinx_mortar.contact.gap_sources import ContactState, GapSource, SlipOperator, StepStart
+from dolfinx_mortar.contact.gap_sources import GapSource, SlipOperator, StepStart
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.layout import assemble_blocks
@@ -160,6 +161,19 @@ class Friction:
         G_T.multTranspose(f, residual)
         f.destroy()
         return FrictionState(slip, mapping, G_T, weights, history, residual)
+
+    def add_to(self, state: ContactState, source: GapSource, u, active: FloatArray,
+               mask: Optional[PETSc.Vec]) -> None:
+        """Friction at ``u`` into ``state``: its forces in the residual, its own
+        state as ``state.friction``. A result at a converged step (no ``mask``)
+        reports that step's return mapping, not one with its forces already
+        made history."""
+        if mask is None and self.at_accepted_step(u):
+            friction = self.history.accepted
+        else:
+            friction = self.evaluate(source, state, u, active, mask)
+        state.residual.axpy(1.0, friction.residual)
+        state.friction = friction
 
     def _node_blocks(self, source: GapSource, values: FloatArray, columns: str) -> PETSc.Mat:
         """A matrix of one block per owned slave-surface node: (gdim × gdim)

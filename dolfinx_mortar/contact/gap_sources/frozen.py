@@ -31,13 +31,13 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.bases.basis import MortarBasis
-from dolfinx_mortar.contact.gap_sources.source import ContactState
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle, relative_to
-from dolfinx_mortar.contact.gap_sources.pointwise import MortarPointGaps, obstacle_positive_gaps
+from dolfinx_mortar.contact.gap_sources.pointwise import point_gaps_of
 from dolfinx_mortar.contact.gap_sources.slip import (SlipOperator, StepStart,
                                                      mortar_slip_operator, obstacle_slip_operator)
 from dolfinx_mortar.kinds import DUAL_KINDS, is_global
@@ -68,8 +68,6 @@ class GapSourceBase:
     def __init__(self, slave: LagrangeSurface, law: PenaltyLaw):
         self.slave = slave
         self.law = law
-        #: the pointwise active set (d̄⁺ = ∫M̄⟨d⟩) instead of the nodal one
-        self.pointwise = law.pointwise
         self.basis = MortarBasis(law.gap_kind, slave)
         #: ω_A of Π_c = Σ (ω_A/2)⟨d̄_A⟩²
         self.weights = law.weights(self.basis.lumped_weights)
@@ -202,6 +200,8 @@ class ObstacleGap(GapSourceBase):
         self.Mbar = np.einsum("cqb,cba->cqa", tab.phi, self.coefficients_std)
         #: slave nodes with something below them (here: all; the obstacle is unbounded)
         self.covered = slave.layout.on_cells(slave.cells)
+        #: the active set's positive gaps (cells cut at d = 0 for the pointwise set)
+        self.points = point_gaps_of(self)
 
     def slip_operator(self, start: StepStart, project: bool = True) -> SlipOperator:
         """Friction's slip operator of the step from ``start`` (``project``
@@ -219,9 +219,7 @@ class ObstacleGap(GapSourceBase):
         at the displacement Function ``u``."""
         u_nodes = nodal_displacement(self.slave, u)
         gaps, G, x = self.nodal_gaps(u_nodes)
-        gaps_plus = G_plus = None
-        if self.pointwise:
-            gaps_plus, G_plus = obstacle_positive_gaps(self, u_nodes, x)
+        gaps_plus, G_plus = self.points.positive_gaps(u.x.petsc_vec, u_nodes, x)
         return gaps, G, x, gaps_plus, G_plus
 
     def curvature(self, force: FloatArray, x: FloatArray) -> Optional[PETSc.Mat]:
@@ -288,9 +286,6 @@ class MortarGap(GapSourceBase):
                  reference: Optional[PETSc.Vec] = None, boundary_modification: bool = False):
         self.reference = reference
         super().__init__(coupling.slave, law)
-        if self.pointwise and coupling.points is None:
-            raise ValueError("the pointwise active set needs MortarCoupling(..., "
-                             "keep_points=True)")
         if coupling.master.layout is not coupling.slave.layout and (
                 coupling.master.layout.size_global != coupling.slave.layout.size_global):
             raise ValueError("MortarGap needs slave and master in one mesh (one displacement "
@@ -331,10 +326,8 @@ class MortarGap(GapSourceBase):
         #: the pairs' slave cells, their columns (slave then master dofs) and
         #: the scalar couplings ``[D̄ | −M̄]`` (pairs, ns, ns + nm): friction's slip
         self.pair_operators = (slave_cells, cols, np.concatenate([Dg, -Mg], axis=2))
-        #: the segment points for the pointwise active set (None: nodal only)
-        self.points = None
-        if self.pointwise:
-            self.points = MortarPointGaps(self)
+        #: the active set's positive gaps (the pointwise set's segment points)
+        self.points = point_gaps_of(self)
 
     def slip_operator(self, start: StepStart, project: bool = True) -> SlipOperator:
         """Friction's slip operator (``[D̄ | −M̄]`` and the segmentation's
@@ -351,9 +344,7 @@ class MortarGap(GapSourceBase):
         """Nodal gaps, G (a copy), None (no curvature), and (pointwise) d̄⁺, G⁺."""
         u.x.scatter_forward()
         gaps = self.nodal_gaps(u.x.petsc_vec)
-        gaps_plus = G_plus = None
-        if self.pointwise:
-            gaps_plus, G_plus = self.points.positive_gaps(u.x.petsc_vec)
+        gaps_plus, G_plus = self.points.positive_gaps(u.x.petsc_vec, None, None)
         return gaps, self.G.copy(), None, gaps_plus, G_plus
 
     def nodal_gaps(self, u: PETSc.Vec) -> FloatArray:

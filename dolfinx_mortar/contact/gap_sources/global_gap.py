@@ -18,7 +18,7 @@ from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.contact.gap_sources.frozen import GapSourceBase
 from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
-from dolfinx_mortar.contact.gap_sources.source import ContactState
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import MassMatrixSolver
 from dolfinx_mortar.mortar.coupling import MortarCoupling
@@ -56,7 +56,6 @@ class GlobalGap:
         self.inner = inner
         self.law = law
         self.slave = inner.slave
-        self.pointwise = inner.pointwise
         self.coupling = inner.coupling
         self.basis = MortarBasis(BasisKind.GLS, self.slave)
         self.mass, W = mass if mass is not None else (self.basis.mass_solver,
@@ -75,7 +74,7 @@ class GlobalGap:
         """``d̄ = L⁻¹ĝ``, Ĝ, and ``z = L⁻¹ω⟨d̄⟩`` (pointwise: ``L⁻¹ω d̄⁺``)."""
         g, G, x, g_plus, G_plus = self.inner.raw_gaps(u)
         gaps = self.mass.solve(g)
-        gaps_plus = self.mass.solve(g_plus) if self.pointwise else None
+        gaps_plus = None if g_plus is None else self.mass.solve(g_plus)
         force = self.mass.solve(self.law.force(self.weights, gaps, gaps_plus))
         K_curv = self.inner.curvature(force, x) if x is not None else None
         return replace(self.inner.state(gaps, G, force, mask, gaps_plus, G_plus, K_curv),

@@ -16,7 +16,7 @@ MUMPS' LU takes as it is. Moving the boundary of {d > 0} adds nothing to
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Optional, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -27,9 +27,6 @@ from dolfinx_mortar.contact.obstacles import relative_to
 from dolfinx_mortar.contact.laws import positive_part
 from dolfinx_mortar.surfaces.lagrange import measure_from_tangents
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
-
-if TYPE_CHECKING:
-    from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -46,7 +43,7 @@ def _assemble_gap_derivative(model, row_cells: npt.NDArray[np.int64],
                            cols.reshape(nb, width), blocks.reshape(nb, nd, width))
 
 
-def obstacle_positive_gaps(model: "ObstacleGap", u_nodes: FloatArray, points: FloatArray
+def obstacle_positive_gaps(model, u_nodes: FloatArray, points: FloatArray
                            ) -> tuple[FloatArray, PETSc.Mat]:
     """``d̄⁺`` at the local slave nodes and ``G⁺`` against a rigid obstacle.
 
@@ -120,7 +117,7 @@ class MortarPointGaps:
     quadrature point q, ``Δu = u − reference``.
     """
 
-    def __init__(self, model: "MortarGap"):
+    def __init__(self, model):
         coupling = model.coupling
         if coupling.points is None:
             raise ValueError("the pointwise active set needs MortarCoupling(..., "
@@ -161,8 +158,9 @@ class MortarPointGaps:
         self.point_derivative.mult(u, d)
         return self.d0 + d.array_r
 
-    def positive_gaps(self, u: PETSc.Vec) -> tuple[FloatArray, PETSc.Mat]:
-        """``d̄⁺`` at the local slave nodes and ``G⁺`` for the displacement u."""
+    def positive_gaps(self, u: PETSc.Vec, u_nodes: Optional[FloatArray] = None,
+                      x: Optional[FloatArray] = None) -> tuple[FloatArray, PETSc.Mat]:
+        """``d̄⁺`` at the local slave nodes and ``G⁺`` for the displacement vector u."""
         d = self.point_gaps(u)
         active = d > 0
         layout = self.model.slave.layout
@@ -170,3 +168,40 @@ class MortarPointGaps:
         a = np.flatnonzero(active)
         blocks = np.einsum("qa,qw->qaw", self.wM[a], self.dd[a])
         return gaps, _assemble_gap_derivative(self.model, self.rows[a], self.cols[a], blocks)
+
+
+class PointGaps(Protocol):
+    """The active set's positive gaps of a frozen source: ``d̄⁺`` and ``G⁺``
+    for the pointwise set, None for the nodal one."""
+
+    def positive_gaps(self, u: PETSc.Vec, u_nodes: FloatArray, x: Optional[FloatArray]
+                      ) -> tuple[Optional[FloatArray], Optional[PETSc.Mat]]:
+        """At the displacement vector ``u`` (its nodal values ``u_nodes``, and
+        the current quadrature points ``x`` against an obstacle)."""
+
+
+class ObstaclePointGaps:
+    """``d̄⁺`` and ``G⁺`` against a rigid obstacle (:func:`obstacle_positive_gaps`)."""
+
+    def __init__(self, model):
+        self.model = model
+
+    def positive_gaps(self, u: PETSc.Vec, u_nodes: FloatArray, x: Optional[FloatArray]
+                      ) -> tuple[FloatArray, PETSc.Mat]:
+        return obstacle_positive_gaps(self.model, u_nodes, x)
+
+
+class NodalSet:
+    """The nodal active set: the penalty acts on ⟨d̄_A⟩, there is no ``d̄⁺``."""
+
+    def positive_gaps(self, u: PETSc.Vec, u_nodes: FloatArray, x: Optional[FloatArray]
+                      ) -> tuple[None, None]:
+        return None, None
+
+
+def point_gaps_of(model) -> PointGaps:
+    """The positive gaps of a frozen source's active set: the one place where
+    the frozen sources' variant (nodal or pointwise, the law's) is chosen."""
+    if not model.law.pointwise:
+        return NodalSet()
+    return ObstaclePointGaps(model) if model.coupling is None else MortarPointGaps(model)

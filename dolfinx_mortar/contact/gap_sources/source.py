@@ -10,61 +10,20 @@ interface.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Optional, Protocol
+from typing import Any, Optional, Protocol
 
 import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.layout import MassMatrixSolver, NodeLayout
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
-if TYPE_CHECKING:  # friction's state is friction's; only its name is needed here
-    from dolfinx_mortar.contact.friction.state import FrictionState
 
 FloatArray = npt.NDArray[np.float64]
-
-
-@dataclass
-class ContactState:
-    """The contact terms at one displacement.
-
-    The contact residual is ``residual = Gᵀ force``. ``G`` is the derivative
-    of the nodal gaps d̄ with respect to the displacement dofs, with the
-    Dirichlet columns dropped (for GLS kinds Ĝ of ĝ, and ``force`` is
-    z = L⁻¹ω⟨d̄⟩). ``gaps_plus`` and ``G_plus`` are the pointwise active set's
-    d̄⁺ and its derivative (None with the nodal set); ``K_curv`` the obstacle's
-    curvature stiffness (None if flat); ``data`` what a model's Jacobian
-    needs beyond that (the current configuration's).
-
-    What the surface was at this displacement is part of the state, not of
-    the model: ``weights`` (ω of the law), ``lumped_weights`` (W),
-    ``covered`` (the slave nodes with something to touch) and
-    ``coefficients`` (M̄ on every slave cell in the displacement's basis, for
-    the traction) are the model's constants with frozen bases and follow u on
-    the current surface.
-    """
-
-    gaps: FloatArray
-    G: PETSc.Mat
-    force: FloatArray
-    residual: PETSc.Vec
-    K_curv: Optional[PETSc.Mat] = None
-    gaps_plus: Optional[FloatArray] = None
-    G_plus: Optional[PETSc.Mat] = None
-    #: the current-surface sources' own state (their
-    #: :class:`~dolfinx_mortar.contact.gap_sources.current.finite_deformation.CurrentState`)
-    data: Optional[object] = None
-    weights: Optional[FloatArray] = None
-    lumped_weights: Optional[FloatArray] = None
-    covered: Optional[npt.NDArray[np.bool_]] = None
-    coefficients: Optional[FloatArray] = None
-    #: friction at this displacement (a
-    #: :class:`~dolfinx_mortar.contact.friction.tangential.FrictionState`; None: frictionless)
-    friction: Optional[FrictionState] = None
 
 
 class GapSource(Protocol):

@@ -56,6 +56,8 @@ class NormalLaw(Protocol):
     m: int
     #: the basis whose integrals are the nodal gaps
     gap_kind: BasisKind
+    #: the law derives from a potential (symmetric Jacobian on frozen bases)
+    has_potential: bool
 
     def weights(self, W: FloatArray) -> FloatArray:
         """``ω_A = ε W_A^m``."""

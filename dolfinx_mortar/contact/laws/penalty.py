@@ -103,6 +103,14 @@ class PenaltyLaw:
             m = 1 if consistent else 0
         return cls(float(penalty), scaling, active_set == "pointwise", k, m, gap)
 
+    @property
+    def has_potential(self) -> bool:
+        """Whether the law derives from the potential ``Σ_A (ω_A/2)⟨y_A⟩²``
+        (the nodal active set; the pointwise one has none): the contact
+        Jacobian is then symmetric on frozen bases, and friction's cone is
+        set by its nodal forces."""
+        return not self.pointwise
+
     # -- frozen configurations: W fixed -------------------------------------------------
     def weights(self, W: FloatArray) -> FloatArray:
         """``ω_A = ε W_A^m`` of Π_c = Σ (ω_A/2)⟨y_A⟩²."""

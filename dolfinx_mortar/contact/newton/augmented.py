@@ -15,7 +15,8 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.gap_sources import ContactState, GlobalGapSource
+from dolfinx_mortar.contact.gap_sources import GlobalGapSource
+from dolfinx_mortar.contact.state import ContactState
 
 FloatArray = npt.NDArray[np.float64]
 

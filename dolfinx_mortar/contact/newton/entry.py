@@ -17,7 +17,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.newton.augmented import AugmentedNewtonStep
-from dolfinx_mortar.contact.gap_sources import ContactState, GapSource
+from dolfinx_mortar.contact.gap_sources import GapSource
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import BasisKind, is_global
 
 FloatArray = npt.NDArray[np.float64]

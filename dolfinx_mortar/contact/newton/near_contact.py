@@ -15,7 +15,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.contact.laws import PenaltyLaw
-from dolfinx_mortar.contact.gap_sources import ContactState, GapSource
+from dolfinx_mortar.contact.gap_sources import GapSource
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.tolerance import NEAR_CONTACT
 
 FloatArray = npt.NDArray[np.float64]

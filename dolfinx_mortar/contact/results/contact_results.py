@@ -29,7 +29,7 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_mortar.contact.gap_sources import ContactState
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
@@ -242,7 +242,7 @@ class ContactResults:
         the normal law has this potential (ω and y of the current surface with
         ``basis_configuration="current"``)."""
         state = state or self.term.evaluate()
-        if self.term.options.law.pointwise:
+        if not self.term.options.law.has_potential:
             raise NotImplementedError("the stored energy is that of the nodal active set: "
                                       "the pointwise one has no potential")
         n = self.term.slave.layout.num_owned

@@ -40,15 +40,16 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
+from dolfinx_mortar.contact.gap_sources.current.exact_jacobian import exact_jacobian
 from dolfinx_mortar.contact.gap_sources.frozen import GapSourceBase
 from dolfinx_mortar.contact.laws import PenaltyLaw, positive_part, safe_weights
 from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
-from dolfinx_mortar.contact.gap_sources.source import ContactState, GapSource
+from dolfinx_mortar.contact.gap_sources.source import GapSource
+from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, is_global, kind_name
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
-from dolfinx_mortar.linalg.sparse_products import transpose_mat_mult
 from dolfinx_mortar.tolerance import local_origin
 
 FloatArray = npt.NDArray[np.float64]
@@ -153,6 +154,8 @@ class CurrentSurfaceGap(GapSourceBase):
                 f"basis_configuration='current' with {kind_name(kind)}: L(u) couples every "
                 "slave facet and its linearization is not implemented; use a local kind")
         super().__init__(slave, law)
+        #: the pointwise active set's virtual work instead of the nodal potential
+        self.pointwise = law.pointwise
         self.kind = kind
         #: the geometry is computed relative to this point, so that x − o + u keeps
         #: u's digits far from the origin (translations change no gap or derivative)
@@ -327,72 +330,12 @@ class CurrentSurfaceGap(GapSourceBase):
         frozen surface would give: positive semi-definite, for the iterations
         in which the active set still moves (see ContactTerm.assemble_jacobian).
         """
-        return self._jacobian(state, active, mask, geometric, structure_only=False)
-
-    def _jacobian(self, state: ContactState, active: FloatArray, mask: Optional[PETSc.Vec],
-                  geometric: bool, structure_only: bool) -> PETSc.Mat:
-        """:meth:`jacobian`; ``structure_only``: every entry it may have, with
-        the gap's second derivatives as structural zeros (not computed)."""
-        weights, state = state.weights, state.data
-        layout = self.slave.layout
-        # pointwise: while nothing penetrates, G⁺ = 0 and the nodal form
-        # (non-geometric) stiffens the touching nodes instead, as when frozen
-        pointwise = (self.pointwise and not structure_only
-                     and self.any_penetration(state.y_plus))
-        if self.pointwise and not structure_only and not pointwise:
-            geometric = False
-        if not geometric:
-            right = (state.G_y_plus if pointwise else state.G_y).copy()
-            right.diagonalScale(layout.vector(weights * (1.0 if pointwise else active)),
-                                None)
-            return transpose_mat_mult(state.G_y, right)
-
-        def scaled(M: PETSc.Mat, s: FloatArray) -> PETSc.Mat:
-            out = M.copy()
-            out.diagonalScale(layout.vector(s), None)
-            return out
-
-        Different = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
-        if pointwise:
-            # ∂F_g = a1 ∂y⁺ + b1 ∂W and ∂F_W = a2 ∂y⁺ + b2 ∂W of the pointwise
-            # virtual work's coefficients
-            _, _, a1, b1, a2, b2 = self.law.pointwise_coefficients(state.y_plus,
-                                                                   safe_weights(state.W))
-            left = scaled(state.G_y_plus, a1)
-            left.axpy(1.0, scaled(state.G_W, b1), structure=Different)
-            right = scaled(state.G_y_plus, a2)
-            right.axpy(1.0, scaled(state.G_W, b2), structure=Different)
-        else:
-            _, _, _, Fgg, FgW, FWW = self.law.nodal_coefficients(state.g, safe_weights(state.W),
-                                                                 active)
-            # outer products: G_gᵀ(Fgg G_g + FgW G_W) + G_Wᵀ(FgW G_g + FWW G_W)
-            left = scaled(state.G_g, Fgg)
-            left.axpy(1.0, scaled(state.G_W, FgW), structure=Different)
-            right = scaled(state.G_g, FgW)
-            right.axpy(1.0, scaled(state.G_W, FWW), structure=Different)
-        K = transpose_mat_mult(state.G_g, left)
-        K.axpy(1.0, transpose_mat_mult(state.G_W, right), structure=Different)
-        # second derivatives: Σ_A F_W,A ∂²W_A (and an obstacle's Σ_A F_g,A ∂²ĝ_A)
-        # from the cells, a master's Σ_A F_g,A ∂²ĝ_A from the pairs
-        if structure_only:
-            width = self.cell_dofs.shape[1]
-            blocks = np.zeros((len(self.cell_dofs), width, width))
-        else:
-            blocks = self._cell_hessians(state.x, state.obstacle, state.FW, state.Fg)
-        K_el = assemble_blocks(self.dofs, self.cell_dofs_local, self.dofs, self.cell_dofs,
-                               blocks)
-        pairs = self._gap_hessian(state.source, None if structure_only else state.Fg)
-        if pairs is not None:
-            K_el.axpy(1.0, pairs, structure=Different)
-        if mask is not None:
-            K_el.diagonalScale(mask, mask)
-            K.diagonalScale(mask, mask)
-        K.axpy(1.0, K_el, structure=Different)
-        return K
+        return exact_jacobian(self, state, active, mask, geometric, structure_only=False)
 
     def pattern(self, state: ContactState) -> PETSc.Mat:
         """The exact Jacobian with every node active: every entry it may have."""
-        return self._jacobian(state, np.ones_like(state.gaps), None, True, structure_only=True)
+        return exact_jacobian(self, state, np.ones_like(state.gaps), None, True,
+                              structure_only=True)
 
     def energy(self, u_nodes: FloatArray) -> float:
         """Π_c summed over all ranks (for checking the residual)."""
