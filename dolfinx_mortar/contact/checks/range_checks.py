@@ -16,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
+from dolfinx_mortar.contact.checks.missed_contact import MissedContact
 from dolfinx_mortar.contact.checks.setup_checks import (check_initial_overlap,
                                                         warn_if_the_obstacle_faces_away)
 from dolfinx_mortar.contact.checks.thresholds import (BODY_PENETRATION, DEEP_PENETRATION,
@@ -89,6 +90,8 @@ class RangeChecks:
         self._body_warned = False
         #: (coupling, slave nodes a four times wider search pairs) of the last check
         self._beyond_radius: Optional[tuple] = None
+        #: the check for contact that the pairs missed
+        self.missed = MissedContact(term, configuration)
         #: times the default search radius was widened, and whether reaching it was warned
         self._radius_widenings = 0
         self._radius_warned = False
@@ -284,6 +287,16 @@ class RangeChecks:
         return bool(comm.allreduce(bool(np.any(reached & near_edge)), op=MPI.LOR))
 
     def wider_search_radius(self, state: Optional[ContactState] = None) -> Optional[float]:
+        """After a converged step: the search radius the term's bases need, None
+        where the present one serves: where the contact zone reached the radius
+        (:meth:`radius_reached`) or where slave nodes passed through the master
+        outside the pairs (:class:`~dolfinx_mortar.contact.checks.missed_contact.MissedContact`;
+        collective)."""
+        state = state or self.term.evaluate()
+        radius = self.radius_reached(state)
+        return radius if radius is not None else self.missed.wider_radius(state)
+
+    def radius_reached(self, state: Optional[ContactState] = None) -> Optional[float]:
         """After a converged step: where the contact zone reached slave nodes
         that found no master within the search radius though one lies beyond it
         (:meth:`contact_reached_the_search_radius`), four times the radius, for
