@@ -23,7 +23,6 @@ from typing import Optional
 import basix
 import numpy as np
 import numpy.typing as npt
-from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
@@ -32,6 +31,7 @@ from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
+from dolfinx_mortar.mortar.facet_search import candidate_pairs
 # the surfaces' geometry lives in surface_normals; these names stay importable here
 from dolfinx_mortar.mortar.surface_normals import (  # noqa: F401
     SurfaceCopy, averaged_nodal_normals, cluster_diameters, current_coordinates,
@@ -152,29 +152,9 @@ class MortarCoupling:
         self.master_global_ids = master_copy.global_ids
         self.master_cells = master_copy.cells
 
-        # each slave facet's diameter (its largest coordinate extent)
-        diameters = cluster_diameters(
-            slave, clusters, np.max(np.ptp(xs[slave.cells], axis=1), axis=1, initial=0.0))
-        if search_radius is None:
-            search_radius = comm.allreduce(float(np.max(diameters, initial=0.0)), op=MPI.MAX)
-        if not np.isfinite(search_radius) or search_radius < 0:
-            raise ValueError(f"search radius must be finite and non-negative, got {search_radius}")
-        self.search_radius = float(search_radius)
         slave_cells = slave.cells.astype(np.int32)
-        if facet_search_factor is None:
-            slave_boxes = swept_facet_boxes(slave, xs, slave_cells, self.search_radius,
-                                            diameters)
-        else:
-            if not (np.isfinite(facet_search_factor) and facet_search_factor > 0):
-                raise ValueError("facet_search_factor must be positive and finite, got "
-                                 f"{facet_search_factor!r}")
-            slave_boxes = _kernels.facet_bounding_boxes(slave.facet_type, xs, slave_cells, 0.0)
-            margin = facet_search_factor * diameters[:, None]
-            slave_boxes[:, :3] -= margin
-            slave_boxes[:, 3:] += margin
-        master_boxes = _kernels.facet_bounding_boxes(master.facet_type, master_copy.x,
-                                                     master_copy.cells, 0.0)
-        candidates = _kernels.overlapping_box_pairs(slave_boxes, master_boxes)
+        self.search_radius, candidates = candidate_pairs(
+            slave, xs, slave_cells, clusters, master_copy, search_radius, facet_search_factor)
         self.timings["search"] = time.perf_counter() - clock
         clock = time.perf_counter()
         degree = quadrature_degree or (polynomial_degree(slave)

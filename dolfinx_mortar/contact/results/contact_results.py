@@ -1,6 +1,8 @@
 """What a contact term reports (``term.results``): gaps, pressures, tractions,
-forces, slip and penetration. The warnings about a configuration that has left
-the model's range are :mod:`~dolfinx_mortar.contact.checks.range_checks`.
+forces, slip and penetration. The friction figures are
+:mod:`~dolfinx_mortar.contact.results.friction_results`', handed on here. The
+warnings about a configuration that has left the model's range are
+:mod:`~dolfinx_mortar.contact.checks.range_checks`.
 
 Each figure, with what it is:
 
@@ -29,12 +31,12 @@ import numpy.typing as npt
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.contact.results.friction_results import FrictionResults, SurfaceFriction
+from dolfinx_mortar.contact.results.surface_nodes import at_surface_nodes, slave_resultant
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
-from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
-
 
 
 @dataclass(frozen=True)
@@ -59,37 +61,14 @@ class SurfacePressure:
     global_index: npt.NDArray[np.int64]
 
 
-@dataclass(frozen=True)
-class SurfaceFriction:
-    """The tangential traction and the stick/slip state at the nodes of a slave
-    surface, in the form of :class:`SurfacePressure`.
-
-    Attributes
-    ----------
-    x
-        Reference (undeformed) coordinates of the nodes, shape (n, gdim).
-    q
-        The tangential traction ``q_A`` on the slave body at them, shape (n, gdim)
-        (:meth:`ContactResults.tangential_tractions`); 0 where separated.
-    stick_slip
-        Their state, shape (n,): 0 separated, 1 stick, 2 slip
-        (:meth:`ContactResults.slip_states`).
-    global_index
-        The nodes' global indices in the displacement space's node numbering.
-    """
-
-    x: FloatArray
-    q: FloatArray
-    stick_slip: npt.NDArray[np.int8]
-    global_index: npt.NDArray[np.int64]
-
-
 class ContactResults:
     """What a :class:`~dolfinx_mortar.contact.term.ContactTerm` reports at the
     present u (or at a state it evaluated): ``term.results``."""
 
     def __init__(self, term):
         self.term = term
+        # the friction figures are a part of their own, handed on below
+        self._friction = FrictionResults(term)
 
     def nodal_gaps(self) -> FloatArray:
         """``d̄_A`` (penetration positive) at the local slave-layout nodes."""
@@ -113,29 +92,8 @@ class ContactResults:
             False: the surface nodes this rank owns, in local order. True: every surface node
             of all ranks, on every rank, sorted by coordinates (x first, then y, then z).
         """
-        x, p, index = self._at_surface_nodes(gather, self.nodal_pressures(state))
+        x, p, index = at_surface_nodes(self.term, gather, self.nodal_pressures(state))
         return SurfacePressure(x, p, index)
-
-    def _at_surface_nodes(self, gather: bool, *values: np.ndarray) -> tuple:
-        """The slave surface's nodes' coordinates, ``values`` (arrays over the
-        local slave-layout nodes) there and the nodes' global indices: this
-        rank's owned surface nodes in local order, or (``gather``) every rank's
-        on every rank, sorted by coordinates. Collective if ``gather``."""
-        slave = self.term.slave
-        layout = slave.layout
-        n = layout.num_owned
-        nodes = np.flatnonzero(layout.on_cells(slave.cells)[:n])
-        part = (slave.x[nodes], [v[nodes] for v in values], layout.global_indices[nodes])
-        if not gather:
-            return (part[0], *part[1], part[2])
-        parts = self.term.comm.allgather(part)
-        x = np.concatenate([q[0] for q in parts]).reshape(-1, slave.gdim)
-        # coordinates equal up to round-off (a mesh generator's 0 may be -2e-18) are equal
-        # here, so that the order does not depend on where round-off lands
-        zero = zero_length(length_scale(x))
-        order = np.lexsort(np.round(x / zero).T[::-1])
-        gathered = [np.concatenate([q[1][k] for q in parts])[order] for k in range(len(values))]
-        return (x[order], *gathered, np.concatenate([q[2] for q in parts])[order])
 
     def mortar_traction(self, state: Optional[ContactState] = None) -> FloatArray:
         """The contact traction ``p*`` at the nodes of every slave cell, (cells, nodes):
@@ -152,16 +110,7 @@ class ContactResults:
     def contact_force(self, state: Optional[ContactState] = None) -> FloatArray:
         """The resultant of the contact traction on the slave body, a gdim-vector:
         ``−Σ R_c`` over the slave nodes' dofs, summed over all ranks."""
-        return self._slave_resultant((state or self.term.evaluate()).residual)
-
-    def _slave_resultant(self, residual: PETSc.Vec) -> FloatArray:
-        """``−Σ residual`` over the slave nodes' owned dofs, summed over all ranks."""
-        gdim = self.term.slave.gdim
-        R = residual.array_r.reshape(-1, gdim)
-        nodes = np.unique(self.term.slave.cells)
-        nodes = nodes[nodes < self.term.slave.layout.num_owned]
-        local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
-        return np.asarray(self.term.comm.allreduce(local))
+        return slave_resultant(self.term, (state or self.term.evaluate()).residual)
 
     def active_nodes(self, state: Optional[ContactState] = None) -> int:
         """The number of slave nodes with a positive pressure, over all ranks."""
@@ -169,71 +118,32 @@ class ContactResults:
         return int(self.term.comm.allreduce(
             int(np.sum(p[: self.term.slave.layout.num_owned] > 0))))
 
-    # -- friction -----------------------------------------------------------------------
-    def _friction(self, state: Optional[ContactState]):
-        if self.term.friction is None:
-            raise ValueError("this contact term has no friction (ContactTerm(..., "
-                             "friction=CoulombFriction(mu)))")
-        return (state or self.term.evaluate()).friction
-
+    # -- friction: FrictionResults' figures, handed on ----------------------------------
     def tangential_tractions(self, state: Optional[ContactState] = None) -> FloatArray:
-        """``q_A = −f_T,A / W_A^k``: the coefficients of the tangential traction
-        on the slave body in the partition-of-unity basis, as ``p_A`` is of the
-        pressure, at the local slave-layout nodes, (nodes, gdim); it opposes
-        the slave's slip relative to what it touches, and ``|q_A| ≤ μ p_A``.
-        With the nodes' coordinates: :meth:`surface_friction`."""
-        state = state or self.term.evaluate()
-        W = state.lumped_weights
-        force = -self._friction(state).mapping.force
-        if self.term.options.law.k == 0:
-            return force.copy()
-        q = np.zeros_like(force)
-        np.divide(force, W[:, None], out=q, where=(W > 0)[:, None])
-        return q
+        """The tangential tractions ``q_A`` (:meth:`.FrictionResults.tangential_tractions`)."""
+        return self._friction.tangential_tractions(state)
 
     def slip_states(self, state: Optional[ContactState] = None) -> npt.NDArray[np.int8]:
-        """Per local slave-layout node: 0 separated, 1 stick, 2 slip
-        (:data:`~dolfinx_mortar.contact.laws.coulomb.STICK`, …). With the
-        nodes' coordinates: :meth:`surface_friction`."""
-        return self._friction(state).mapping.state.copy()
+        """The stick/slip state per node (:meth:`.FrictionResults.slip_states`)."""
+        return self._friction.slip_states(state)
 
     def surface_friction(self, state: Optional[ContactState] = None,
                          gather: bool = False) -> SurfaceFriction:
-        """The tangential traction and the stick/slip state at the slave
-        surface's nodes, with their coordinates (as :meth:`surface_pressure`).
-
-        Collective.
-
-        Parameters
-        ----------
-        state
-            A contact state; by default the one at the present u.
-        gather
-            False: the surface nodes this rank owns, in local order. True: every surface node
-            of all ranks, on every rank, sorted by coordinates (x first, then y, then z).
-
-        Raises
-        ------
-        ValueError
-            If the term has no friction.
-        """
-        state = state or self.term.evaluate()
-        x, q, stick_slip, index = self._at_surface_nodes(
-            gather, self.tangential_tractions(state), self.slip_states(state))
-        return SurfaceFriction(x, q, stick_slip, index)
+        """``q_A`` and the stick/slip states with the nodes' coordinates
+        (:meth:`.FrictionResults.surface_friction`). Collective."""
+        return self._friction.surface_friction(state, gather)
 
     def tangential_force(self, state: Optional[ContactState] = None) -> FloatArray:
-        """The resultant of the tangential (friction) traction on the slave
-        body, a gdim-vector over all ranks: ``−Σ G_Tᵀ f_T`` over the slave
-        nodes' dofs, as :meth:`contact_force` is of the whole traction."""
-        return self._slave_resultant(self._friction(state).residual)
+        """The resultant of the friction traction (:meth:`.FrictionResults.tangential_force`)."""
+        return self._friction.tangential_force(state)
 
     def dissipation(self) -> float:
-        """The frictional dissipation ``Σ_steps Σ_A f_T,A · Δy_p,A`` over the
-        accepted steps, over all ranks."""
-        if self.term.friction is None:
-            return 0.0
-        return self.term.friction.history.dissipation
+        """The frictional dissipation so far (:meth:`.FrictionResults.dissipation`)."""
+        return self._friction.dissipation()
+
+    def friction_summary(self, state: Optional[ContactState] = None) -> Optional[dict]:
+        """The friction figures of a step (:meth:`.FrictionResults.friction_summary`)."""
+        return self._friction.friction_summary(state)
 
     def stored_energy(self, state: Optional[ContactState] = None) -> float:
         """The energy stored in the contact's penalty springs over all ranks:
@@ -251,25 +161,6 @@ class ContactResults:
         if self.term.friction is not None:
             energy += self.term.friction.stored_energy(state.friction)
         return energy
-
-    def friction_summary(self, state: Optional[ContactState] = None) -> Optional[dict]:
-        """The friction figures of a step, for the load path's history: None
-        without friction, else ``tangential_force`` (list), ``dissipation``
-        (total), ``step_dissipation``, ``stick_nodes``, ``slip_nodes``,
-        ``tangential_energy`` (the tangential springs' stored energy)."""
-        if self.term.friction is None:
-            return None
-        state = state or self.term.evaluate()
-        n = self.term.slave.layout.num_owned
-        states = self.slip_states(state)[:n]
-        comm = self.term.comm
-        history = self.term.friction.history
-        return {"tangential_force": self.tangential_force(state).tolist(),
-                "dissipation": history.dissipation,
-                "step_dissipation": history.step_dissipation,
-                "stick_nodes": int(comm.allreduce(int(np.sum(states == 1)))),
-                "slip_nodes": int(comm.allreduce(int(np.sum(states == 2)))),
-                "tangential_energy": self.term.friction.stored_energy(state.friction)}
 
     def node_lengths(self) -> FloatArray:
         """Each local slave node's element length: the largest of its cells'."""

@@ -1,0 +1,72 @@
+"""What the pressure and the friction reports share: values at the slave
+surface's nodes with the nodes' coordinates (per rank or gathered), and the
+resultant of a residual on the slave body."""
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+from petsc4py import PETSc
+
+from dolfinx_mortar.tolerance import length_scale, zero_length
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def at_surface_nodes(term, gather: bool, *values: np.ndarray) -> tuple:
+    """The slave surface's nodes' coordinates, ``values`` there and the nodes' global indices.
+
+    Collective if ``gather``.
+
+    Parameters
+    ----------
+    term
+        The :class:`~dolfinx_mortar.contact.term.ContactTerm` reporting.
+    gather
+        False: the surface nodes this rank owns, in local order. True: every surface node
+        of all ranks, on every rank, sorted by coordinates (x first, then y, then z).
+    *values
+        Arrays over the local slave-layout nodes.
+
+    Returns
+    -------
+    tuple
+        ``(x, *values at the nodes, global indices)``.
+    """
+    slave = term.slave
+    layout = slave.layout
+    n = layout.num_owned
+    nodes = np.flatnonzero(layout.on_cells(slave.cells)[:n])
+    part = (slave.x[nodes], [v[nodes] for v in values], layout.global_indices[nodes])
+    if not gather:
+        return (part[0], *part[1], part[2])
+    parts = term.comm.allgather(part)
+    x = np.concatenate([q[0] for q in parts]).reshape(-1, slave.gdim)
+    # coordinates equal up to round-off (a mesh generator's 0 may be -2e-18) are equal
+    # here, so that the order does not depend on where round-off lands
+    zero = zero_length(length_scale(x))
+    order = np.lexsort(np.round(x / zero).T[::-1])
+    gathered = [np.concatenate([q[1][k] for q in parts])[order] for k in range(len(values))]
+    return (x[order], *gathered, np.concatenate([q[2] for q in parts])[order])
+
+
+def slave_resultant(term, residual: PETSc.Vec) -> FloatArray:
+    """``−Σ residual`` over the slave nodes' owned dofs, summed over all ranks.
+
+    Parameters
+    ----------
+    term
+        The :class:`~dolfinx_mortar.contact.term.ContactTerm` reporting.
+    residual
+        A residual in the displacement space (blocked by gdim).
+
+    Returns
+    -------
+    FloatArray
+        A gdim-vector, the same on every rank.
+    """
+    gdim = term.slave.gdim
+    R = residual.array_r.reshape(-1, gdim)
+    nodes = np.unique(term.slave.cells)
+    nodes = nodes[nodes < term.slave.layout.num_owned]
+    local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
+    return np.asarray(term.comm.allreduce(local))

@@ -1,0 +1,79 @@
+"""Which master facets a slave facet may touch: the bounding-box search that
+proposes the candidate pairs a coupling segments (docs/DESIGN.md, §Segmentation)."""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+from dolfinx_mortar import _kernels
+from dolfinx_mortar.mortar.surface_normals import (SurfaceCopy, cluster_diameters,
+                                                   swept_facet_boxes)
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def candidate_pairs(slave: LagrangeSurface, xs: FloatArray, slave_cells: npt.NDArray[np.int32],
+                    clusters: dict[int, int], master_copy: SurfaceCopy,
+                    search_radius: Optional[float],
+                    facet_search_factor: Optional[float]) -> tuple[float, npt.NDArray]:
+    """The slave–master facet pairs whose search boxes overlap.
+
+    Collective when ``search_radius`` is None (its default is reduced over all ranks).
+
+    Parameters
+    ----------
+    slave
+        The slave surface (this rank's cells).
+    xs
+        The slave nodes' coordinates in the configuration of the coupling.
+    slave_cells
+        The slave cells' nodes, as the kernels take them (int32).
+    clusters
+        The slave nodes that share a normal (:func:`normal_clusters`).
+    master_copy
+        The master surface gathered from all ranks.
+    search_radius
+        How far along its normal a slave facet reaches; None: the largest slave
+        facet diameter over all ranks.
+    facet_search_factor
+        Instead of one radius, each slave facet reaches this multiple of its own
+        diameter (see :class:`~dolfinx_mortar.mortar.coupling.MortarCoupling`).
+
+    Returns
+    -------
+    tuple
+        The search radius used and the candidate pairs (slave cell, master cell in
+        the gathered master).
+
+    Raises
+    ------
+    ValueError
+        If the search radius is negative or not finite, or the factor not positive
+        and finite.
+    """
+    # each slave facet's diameter (its largest coordinate extent)
+    diameters = cluster_diameters(
+        slave, clusters, np.max(np.ptp(xs[slave.cells], axis=1), axis=1, initial=0.0))
+    if search_radius is None:
+        search_radius = slave.layout.comm.allreduce(float(np.max(diameters, initial=0.0)),
+                                                    op=MPI.MAX)
+    if not np.isfinite(search_radius) or search_radius < 0:
+        raise ValueError(f"search radius must be finite and non-negative, got {search_radius}")
+    search_radius = float(search_radius)
+    if facet_search_factor is None:
+        slave_boxes = swept_facet_boxes(slave, xs, slave_cells, search_radius, diameters)
+    else:
+        if not (np.isfinite(facet_search_factor) and facet_search_factor > 0):
+            raise ValueError("facet_search_factor must be positive and finite, got "
+                             f"{facet_search_factor!r}")
+        slave_boxes = _kernels.facet_bounding_boxes(slave.facet_type, xs, slave_cells, 0.0)
+        margin = facet_search_factor * diameters[:, None]
+        slave_boxes[:, :3] -= margin
+        slave_boxes[:, 3:] += margin
+    master_boxes = _kernels.facet_bounding_boxes(master_copy.facet_type, master_copy.x,
+                                                 master_copy.cells, 0.0)
+    return search_radius, _kernels.overlapping_box_pairs(slave_boxes, master_boxes)
