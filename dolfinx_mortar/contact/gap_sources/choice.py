@@ -17,6 +17,7 @@ from mpi4py import MPI
 from dolfinx_mortar.contact.gap_sources.current import CurrentMortarGap
 from dolfinx_mortar.contact.gap_sources.current import CurrentObstacleGap
 from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
+from dolfinx_mortar.contact.gap_sources.self_contact import SelfContactGap
 from dolfinx_mortar.contact.gap_sources.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
@@ -58,9 +59,10 @@ def frozen_model(options: ContactOptions, slave: LagrangeSurface,
             slave, master = slave.moved(u_nodes), master.moved(u_nodes)
         coupling = MortarCoupling(slave, master, keep_points=law.pointwise,
                                   search_radius=options.search_radius,
-                                  interface_normals=True)
-        model = MortarGap(coupling, law, None if u_nodes is None else u_vector,
-                          boundary_modification=options.boundary_modification)
+                                  interface_normals=True, self_contact=options.self_contact)
+        source = SelfContactGap if options.self_contact else MortarGap
+        model = source(coupling, law, None if u_nodes is None else u_vector,
+                       boundary_modification=options.boundary_modification)
         mass = covered_mass(coupling) if is_global(options.kind) else None
     if is_global(options.kind):
         return GlobalGap(model, law, mass)
