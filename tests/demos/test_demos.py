@@ -83,7 +83,7 @@ def test_quickstart_runs_and_balances(tmp_path, monkeypatch):
 
 
 def test_stack_of_blocks_every_interface_carries_the_load(tmp_path, monkeypatch):
-    """Three contact terms in one problem, as printed in the README: every
+    """Three contact terms in one problem, as printed in docs/OPEN_MODEL.md: every
     interface carries the whole load (to Newton's tolerance; the ground, the
     only support, to round-off), and each term writes its own file, named by
     the term's name."""
@@ -105,6 +105,20 @@ def test_stack_of_blocks_every_interface_carries_the_load(tmp_path, monkeypatch)
         mean = load / (x1 - x0)
         assert 0.5 * mean < p_hat[-1].max() < 10 * mean
     assert not (folder / "stack_of_blocks_slave.xdmf").exists()
+
+
+def test_a_stack_under_one_term_carries_the_pressure_at_every_interface():
+    """Three blocks on non-matching meshes, both interfaces in ONE self-contact term
+    (a list of four face tags, no slave or master named), uniform pressure: every
+    node of the four faces carries q to round-off, the ground the whole load, and
+    the term's forces cancel inside the stack (a patch test; docs/SELF_CONTACT.md)."""
+    figures = load_demo("stack_one_term").main([])
+    q = figures["load"]
+    assert figures["interface_nodes"] > 0
+    assert figures["interface_pressure_min"] == pytest.approx(q, rel=1e-9)
+    assert figures["interface_pressure_max"] == pytest.approx(q, rel=1e-9)
+    assert figures["ground_force"] == pytest.approx(q, rel=1e-12)
+    assert figures["internal_force"] < 1e-12 * q
 
 
 def test_press_and_slide_frictionless_sliding_needs_no_tangential_force(out):
