@@ -130,6 +130,20 @@ def test_what_self_contact_refuses_is_named(arguments, error, match):
                     **{"kind": "LcLS*", **arguments})
 
 
+def test_a_body_that_overlaps_itself_at_the_start_is_refused_naming_where():
+    """The C body with its lower arm bent up into the upper one by 0.04 at the
+    apex (0.8 of its facets): an error on every rank naming a node, where two
+    bodies would get a warning only."""
+    V, tags, _ = c_body_surface()
+    x = V.mesh.geometry.x
+    lower = x[:, 1] < 0
+    x[lower, 1] += 0.04 * np.maximum(0.0, 1.0 - x[lower, 0] / 0.5) ** 2
+    V = fem.functionspace(V.mesh, ("Lagrange", 1, (2,)))
+    with pytest.raises(ValueError, match=r"overlaps itself at the start: the node \[") as err:
+        ContactTerm(fem.Function(V), tags, CONTACT, self_contact=True, penalty=1e3)
+    assert "element lengths" in str(err.value)
+
+
 def test_a_self_contact_tag_that_marks_nothing_is_named():
     V, tags, _ = c_body_surface()
     with pytest.raises(ValueError, match="17"):

@@ -119,6 +119,11 @@ class RangeChecks:
         on_local_cell[slave.cells] = True
         covered = state.covered & on_local_cell
         ratio, gap, x = self.term.results.deepest(np.where(covered, state.gaps, -np.inf))
+        if ratio > DEEP_PENETRATION and self.term.options.self_contact:
+            raise ValueError(f"the surface overlaps itself at the start: the node {x} lies "
+                             f"{gap:.3g} ({ratio:.3g} element lengths) inside the body's own "
+                             "surface. A self-contact surface must start without overlaps: "
+                             "check the geometry and the tag")
         if ratio > DEEP_PENETRATION:
             hint = ""
             options = self.term.options
