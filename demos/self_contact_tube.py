@@ -105,8 +105,17 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
     result = LoadPathSolver(problem).solve(lambda t: top.move_to([0.0, -args.squeeze * t]),
                                            load_steps=args.steps, on_step=record)
     figures = {"steps": steps, "newton_iterations": result.newton_iterations,
-               "h": args.h, "kind": args.kind}
+               "h": args.h, "kind": args.kind,
+               # wall times (s) over the whole path: the self-contact term's work by part,
+               # and the bulk's assembly, to compare per Newton iteration
+               "self_contact_timings": dict(terms[2].timings),
+               "bulk_assembly_s": sum(v for k, v in problem.timings.items()
+                                      if k.startswith("bulk_"))}
     if comm.rank == 0:
+        work = sum(v for k, v in figures["self_contact_timings"].items() if k != "setup")
+        print(f"{result.newton_iterations} Newton iterations: self-contact "
+              f"{work / result.newton_iterations * 1e3:.2f} ms per iteration, bulk assembly "
+              f"{figures['bulk_assembly_s'] / result.newton_iterations * 1e3:.2f} ms")
         for s in steps:
             print(f"squeeze {s['squeeze']:.3f}: plate force {s['plate_force']:.4g}, "
                   f"self-contact p_max {s['self_contact_pressure']:.3g} on "
