@@ -104,7 +104,4 @@ def check_self_contact(kind: BasisKind, basis_configuration: str, pointwise: boo
             "self_contact=True with a GLS kind: its L couples every facet of the surface, "
             "and a surface that pairs with itself has not been verified with it; use a local "
             "kind (LcLS*, LcLS, LmLS*, LmLS)")
-    if basis_configuration == "current":
-        raise NotImplementedError(
-            "self_contact=True with basis_configuration='current': the current surface's pair "
-            "search does not yet exclude a facet's neighbours on the surface; use 'previous'")
+

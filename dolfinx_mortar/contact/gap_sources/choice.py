@@ -17,7 +17,7 @@ from mpi4py import MPI
 from dolfinx_mortar.contact.gap_sources.current import CurrentMortarGap
 from dolfinx_mortar.contact.gap_sources.current import CurrentObstacleGap
 from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
-from dolfinx_mortar.contact.gap_sources.self_contact import SelfContactGap
+from dolfinx_mortar.contact.gap_sources.self_contact import CurrentSelfContactGap, SelfContactGap
 from dolfinx_mortar.contact.gap_sources.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
@@ -36,6 +36,8 @@ def current_model(options: ContactOptions, slave: LagrangeSurface,
     measures each step's slip on the frozen model where the step starts."""
     if obstacle is not None:
         model = CurrentObstacleGap(slave, obstacle, options.kind, options.law)
+    elif options.self_contact:
+        model = CurrentSelfContactGap(slave, options.kind, options.law, options.search_radius)
     else:
         model = CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius)
     model.frozen_at = partial(frozen_model, options, slave, master, obstacle)
