@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 from typing import Optional, Sequence
 
+import dolfinx.mesh
 import gmsh
 import numpy as np
 from dolfinx import fem
@@ -30,12 +31,14 @@ from dolfinx_mortar.io.gmsh_io import model_to_mesh
 from dolfinx_mortar.io.output import save_figure, write_json
 
 R, r = 1.0, 0.4
-INNER, OUTER_TOP, OUTER_BOTTOM, CUT = 1, 2, 3, 4
+INNER, OUTER_TOP, OUTER_BOTTOM, CUT, END = 1, 2, 3, 4, 5
 
 
-def tube(comm: MPI.Comm, h: float):
-    """The right half of the ring, triangles of size h: mesh and facet tags."""
+def tube(comm: MPI.Comm, h: float, length: float = 0.0):
+    """The right half of the ring, triangles of size h (with a ``length``: that much of the
+    tube in z, tetrahedra): mesh and facet tags, found on the geometry."""
     gmsh.initialize(["", "-v", "0"])
+    dim = 3 if length else 2
     try:
         if comm.rank == 0:
             geo = gmsh.model.geo
@@ -46,18 +49,29 @@ def tube(comm: MPI.Comm, h: float):
             inner = [geo.addCircleArc(p[1, r], c, right[r]), geo.addCircleArc(right[r], c, p[-1, r])]
             cuts = [geo.addLine(p[1, R], p[1, r]), geo.addLine(p[-1, r], p[-1, R])]
             loop = geo.addCurveLoop([outer[0], outer[1], cuts[0], inner[0], inner[1], cuts[1]])
-            geo.addPlaneSurface([loop])
+            section = geo.addPlaneSurface([loop])
+            if length:
+                layers = max(1, int(round(length / h)))
+                body = [e[1] for e in geo.extrude([(2, section)], 0, 0, length, [layers])
+                        if e[0] == 3]
             geo.synchronize()
-            gmsh.model.addPhysicalGroup(2, [1], 1)
-            gmsh.model.addPhysicalGroup(1, inner, INNER)
-            gmsh.model.addPhysicalGroup(1, [outer[1]], OUTER_TOP)
-            gmsh.model.addPhysicalGroup(1, [outer[0]], OUTER_BOTTOM)
-            gmsh.model.addPhysicalGroup(1, cuts, CUT)
-            gmsh.model.mesh.generate(2)
-        mesh, _, facet_tags = model_to_mesh(gmsh.model, comm, 0, gdim=2)
+            gmsh.model.addPhysicalGroup(dim, body if length else [section], 1)
+            gmsh.model.mesh.generate(dim)
+        mesh, _, _ = model_to_mesh(gmsh.model, comm, 0, gdim=dim)
     finally:
         gmsh.finalize()
-    return mesh, facet_tags
+    radius = lambda x: np.hypot(x[0], x[1])           # noqa: E731
+    marks = [(INNER, lambda x: np.isclose(radius(x), r, atol=1e-3 * h)),
+             (OUTER_TOP, lambda x: np.isclose(radius(x), R, atol=1e-3 * h) & (x[1] >= 0)),
+             (OUTER_BOTTOM, lambda x: np.isclose(radius(x), R, atol=1e-3 * h) & (x[1] <= 0)),
+             (CUT, lambda x: np.isclose(x[0], 0.0))]
+    if length:
+        marks.append((END, lambda x: np.isclose(x[2], 0.0)))
+    fdim = dim - 1
+    facets = [dolfinx.mesh.locate_entities_boundary(mesh, fdim, where) for _, where in marks]
+    values = np.concatenate([np.full(len(f), t, np.int32) for f, (t, _) in zip(facets, marks)])
+    facets, first = np.unique(np.concatenate(facets), return_index=True)
+    return mesh, dolfinx.mesh.meshtags(mesh, fdim, facets.astype(np.int32), values[first])
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
@@ -66,6 +80,9 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--squeeze", type=float, default=0.95, help="the plate's travel (0.95)")
     parser.add_argument("--steps", type=int, default=19, help="load steps (19)")
     parser.add_argument("--kind", default="LmLS*", help="mortar basis kind (LmLS*)")
+    parser.add_argument("--length", type=float, default=0.0,
+                        help="0: plane strain; else a tube this long in 3D, held in z at z = 0 "
+                             "(a symmetry plane) and free at its other end")
     parser.add_argument("--json", help="write the figures to this file")
     parser.add_argument("--png", help="write the figure to this file")
     return parser.parse_args(argv)
@@ -74,18 +91,25 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
 def main(argv: Optional[Sequence[str]] = None) -> dict:
     args = parse_args(argv)
     comm = MPI.COMM_WORLD
-    mesh, tags = tube(comm, args.h)
-    V = fem.functionspace(mesh, ("Lagrange", 1, (2,)))
+    mesh, tags = tube(comm, args.h, args.length)
+    dim = mesh.geometry.dim
+    V = fem.functionspace(mesh, ("Lagrange", 1, (dim,)))
     u = fem.Function(V, name="u")
     E, nu = 1.0, 0.3
     F = neo_hookean_residual(u, E, nu)
-    cut = fem.locate_dofs_topological(V.sub(0), 1, tags.find(CUT))
+    cut = fem.locate_dofs_topological(V.sub(0), dim - 1, tags.find(CUT))
     bcs = [fem.dirichletbc(0.0, cut, V.sub(0))]
+    if dim == 3:
+        end = fem.locate_dofs_topological(V.sub(2), 2, tags.find(END))
+        bcs.append(fem.dirichletbc(0.0, end, V.sub(2)))
     penalty = 100 * E / args.h
     options = dict(kind=args.kind, penalty=penalty, basis_configuration="previous")
-    top = RigidPlane([0.0, R], [0.0, -1.0])
+    def plane(y: float, ny: float) -> RigidPlane:
+        return RigidPlane([0.0, y, 0.0][:dim], [0.0, ny, 0.0][:dim])
+
+    top = plane(R, -1.0)
     terms = [ContactTerm(u, tags, OUTER_TOP, obstacle=top, name="top", **options),
-             ContactTerm(u, tags, OUTER_BOTTOM, obstacle=RigidPlane([0.0, -R], [0.0, 1.0]),
+             ContactTerm(u, tags, OUTER_BOTTOM, obstacle=plane(-R, 1.0),
                          name="bottom", **options),
              ContactTerm(u, tags, INNER, self_contact=True, name="inner", **options)]
     problem = NonlinearContactProblem(F, u, terms, bcs)
@@ -102,10 +126,10 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
                       "self_contact_nodes": int(touching.sum()),
                       "self_contact_length": length, "newton_iterations": step.newton_iterations})
 
-    result = LoadPathSolver(problem).solve(lambda t: top.move_to([0.0, -args.squeeze * t]),
+    result = LoadPathSolver(problem).solve(lambda t: top.move_to([0.0, -args.squeeze * t, 0.0][:dim]),
                                            load_steps=args.steps, on_step=record)
     figures = {"steps": steps, "newton_iterations": result.newton_iterations,
-               "h": args.h, "kind": args.kind,
+               "h": args.h, "kind": args.kind, "length": args.length,
                # wall times (s) over the whole path: the self-contact term's work by part,
                # and the bulk's assembly, to compare per Newton iteration
                "self_contact_timings": dict(terms[2].timings),

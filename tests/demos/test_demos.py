@@ -143,6 +143,19 @@ def test_a_tube_squeezed_until_its_inner_faces_meet(out):
         assert (out / "tube.json").exists() and (out / "tube.png").exists()
 
 
+def test_a_tube_in_3d_squeezed_until_its_inner_faces_meet():
+    """The same, 3D: 0.3 of the tube (tetrahedra, h = 0.1), a symmetry plane at z = 0
+    and a free end: self-contact and finite strain in 3D (measured: the faces meet
+    first at 0.855, the plate force's increment per step grows from 0.003 to 0.018)."""
+    steps = load_demo("self_contact_tube").main(
+        ["--h", "0.1", "--steps", "10", "--length", "0.3"])["steps"]
+    touching = [s["self_contact_nodes"] > 0 for s in steps]
+    assert not any(touching[:7]) and all(touching[8:])
+    force = np.array([-s["plate_force"] for s in steps])
+    assert np.all(np.diff(force) > 0)
+    assert force[-1] - force[-2] > 3 * (force[1] - force[0])
+
+
 def test_press_and_slide_frictionless_sliding_needs_no_tangential_force(out):
     """A rigid cylinder pressed into a neo-Hookean block and slid by 8 elements
     (coarse: h = 0.1, 4 steps per element, basis_configuration="current").
