@@ -181,6 +181,30 @@ def test_a_body_that_overlaps_itself_at_the_start_is_refused_naming_where():
     assert "element lengths" in str(err.value)
 
 
+def test_the_output_covers_both_sides_of_a_self_contact(tmp_path):
+    """The XDMF series of a self-contact term: the pressure p̂ on every node of
+    the surface, whichever side of a pair it was on (both arms carry it, equal
+    by symmetry within the mesh's asymmetry)."""
+    from dolfinx_mortar import read_xdmf_series
+    from demo_support.self_mirror import BOTTOM, SYMMETRY_X, TOP
+    folder = MPI.COMM_WORLD.bcast(str(tmp_path), root=0)
+    domain, tags = build(MPI.COMM_WORLD, 0.05, whole=True)
+    V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
+    problem = ContactProblem(V, tags, CONTACT, self_contact=True, E=1.0, nu=0.3, penalty=1e4,
+                             fixed={TOP: {1: -0.02}, BOTTOM: {1: 0.02}, SYMMETRY_X: {0: 0.0}})
+    problem.solve(load_steps=1, output=f"{folder}/run.xdmf")
+    pressures = problem.surface_pressure(gather=True)
+    data = read_xdmf_series(f"{folder}/run_slave.xdmf")
+    _, p_hat = data.field("p_hat")
+    upper, lower = pressures.p[pressures.x[:, 1] > 0], pressures.p[pressures.x[:, 1] < 0]
+    assert upper.max() > 0 and lower.max() > 0
+    assert upper.max() == pytest.approx(lower.max(), rel=0.05)
+    # the file's nodes (one copy per facet) on both arms carry the pressure
+    y, written = data.geometry[:, 1], p_hat[-1].reshape(len(data.geometry), -1)[:, 0]
+    assert written[y > 0].max() == pytest.approx(upper.max(), rel=1e-12)
+    assert written[y < 0].max() == pytest.approx(lower.max(), rel=1e-12)
+
+
 def test_a_self_contact_tag_that_marks_nothing_is_named():
     V, tags, _ = c_body_surface()
     with pytest.raises(ValueError, match="17"):
