@@ -76,7 +76,7 @@ def main() -> None:
     callbacks = sum(v for k, v in t.items() if k.startswith(("contact_", "bulk_"))
                     and k != "contact_setup")
     row = {"solver": "MUMPS" if args.solver == "direct" else "iterative",
-           "refine": args.refine, "ranks": comm.size, "dofs": problem.problem.num_dofs,
+           "refine": args.refine, "ranks": comm.size, "dofs": problem.u.x.petsc_vec.getSize(),
            "setup_s": setup, "iteration_s": iteration,
            "linear_s": comm.allreduce(max(iteration - callbacks, 0.0), op=MPI.MAX),
            "krylov": krylov, "peak_memory_gb": peak_memory_gb(comm), "load_average": load,

@@ -49,13 +49,13 @@ from dolfinx_mortar.surfaces import lagrange, nurbs
 
 _LAZY = {
     "ContactTerm": "dolfinx_mortar.contact.term",
-    "NonlinearContactProblem": "dolfinx_mortar.solver.nonlinear_problem",
-    "reaction_force": "dolfinx_mortar.solver.nonlinear_problem",
-    "NewtonSolver": "dolfinx_mortar.solver.newton_solver",
-    "LoadPathSolver": "dolfinx_mortar.solver.load_path",
+    "NonlinearContactProblem": "dolfinx_mortar.solver",
+    "reaction_force": "dolfinx_mortar.solver",
+    "NewtonSolver": "dolfinx_mortar.solver",
+    "LoadPathSolver": "dolfinx_mortar.solver",
     "read_xdmf_series": "dolfinx_mortar.io.read_series",
     "ContactProblem": "dolfinx_mortar.small_strain.elastic",
-    "ContactDivergenceError": "dolfinx_mortar.solver.convergence",
+    "ContactDivergenceError": "dolfinx_mortar.solver",
     "RigidPlane": "dolfinx_mortar.contact.obstacles",
     "RigidSphere": "dolfinx_mortar.contact.obstacles",
     "RigidCylinder": "dolfinx_mortar.contact.obstacles",

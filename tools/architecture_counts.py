@@ -57,9 +57,11 @@ from __future__ import annotations
 import argparse
 import ast
 import re
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
+
+from architecture_imports import folder_counts, import_counts
+from architecture_tree import Count, Tree, name_of, order, places
 
 HERE = Path(__file__).resolve().parents[1]
 #: modules allowed to ask which configuration or Newton entry a term has
@@ -74,7 +76,6 @@ KERNEL_KEYS = ("value", "gradient", "hessian", "nodes", "value_plus", "gradient_
                "normals", "weights", "pairs", "slave_N", "master_N", "D", "M", "g")
 POSITIVE_PART = re.compile(r"np\.maximum\((?!.*(length|count|tiny|x\[))[^,]+,\s*0\.0\)")
 PENALTY_FORCE = re.compile(r"\b(penalty|eps) \*(?! ratio)")
-GAP_SOURCES = "contact/gap_sources/"
 PROTOCOL_NAMES = ("GapSource", "GapModel")
 GAP_SOURCE_EXPRESSIONS = {"model", "source", "inner", "self.model", "self._model", "self.source",
                           "self._source", "self.inner", "term.model", "self.term.model",
@@ -89,93 +90,6 @@ PUBLIC_CLASSES = {"ContactTerm": "contact/term.py",
                   "NonlinearContactProblem": "solver/nonlinear_problem.py",
                   "LoadPathSolver": "solver/load_path.py"}
 KIND_OWNERS = ("kinds.py", "bases/", "mortar/")
-EXTENSIONS = {"dolfinx_mortar._kernels"}
-IMPORT_KINDS = ("module-level", "type-hint", "function-local")
-FOLDER_LINES, FOLDER_MODULES = 1500, 10
-#: path in the layout by concept: path in the flat contact/ (ea0a892), both under contact/
-OLD_PATHS = {f"contact/{new}": f"contact/{old}" for new, old in (pair.split(":") for pair in """
-    checks/range_checks.py:checks.py checks/setup_checks.py:setup_checks.py
-    friction/state.py:friction_state.py friction/tangential.py:friction.py
-    gap_sources/choice.py:models.py gap_sources/configuration.py:configuration.py
-    gap_sources/current/finite_deformation.py:finite_deformation.py
-    gap_sources/current/mortar.py:current_mortar.py
-    gap_sources/current/obstacle.py:current_obstacle.py
-    gap_sources/cut_quadrature.py:cut_quadrature.py gap_sources/frozen.py:gaps.py
-    gap_sources/global_gap.py:global_gap.py gap_sources/pointwise.py:pointwise.py
-    gap_sources/source.py:state.py laws/coulomb.py:friction_law.py laws/penalty.py:penalty_law.py
-    newton/augmented.py:augmented.py newton/entry.py:newton_entry.py
-    newton/near_contact.py:active_set.py obstacles/analytic.py:obstacles.py
-    results/contact_results.py:results.py""".split())}
-
-
-@dataclass
-class Count:
-    """A number (None: nothing to count by this rule in this tree), its places and a note."""
-    value: Optional[int]
-    items: list[str] = field(default_factory=list)
-    note: str = ""
-
-    def shown(self) -> str:
-        number = "–" if self.value is None else str(self.value)
-        return number + (f" ({self.note})" if self.note else "")
-
-
-def module_name(rel: str) -> str:
-    parts = rel[:-3].split("/")
-    return ".".join(["dolfinx_mortar", *(parts[:-1] if parts[-1] == "__init__" else parts)])
-
-
-def short(module: str) -> str:
-    return module.removeprefix("dolfinx_mortar.")
-
-
-def name_of(node: ast.AST) -> Optional[str]:
-    """The name a Name or an Attribute ends in."""
-    return getattr(node, "id", getattr(node, "attr", None))
-
-
-def order(place: str) -> list[tuple[int, str]]:
-    """A sort key of ``file:line …``: by file, then by line number."""
-    return [(int(p), "") if p.isdigit() else (-1, p) for p in re.split(r"[: ]", place)]
-
-
-def places(found: dict[str, list[str]]) -> list[str]:
-    """``key (where, …)`` for each key, its places in file and line order, once each."""
-    return [f"{key} ({', '.join(sorted(set(where), key=order))})"
-            for key, where in sorted(found.items())]
-
-
-class Tree:
-    """The package of one checkout, parsed once."""
-
-    def __init__(self, root: Path):
-        self.root = Path(root).resolve()
-        self.package = self.root / "dolfinx_mortar"
-        if not self.package.is_dir():
-            raise SystemExit(f"{root}: no dolfinx_mortar/ package there")
-        self.paths = {p.relative_to(self.package).as_posix(): p for p in
-                      sorted(self.package.rglob("*.py")) if "__pycache__" not in p.parts}
-        self.text = {rel: p.read_text() for rel, p in self.paths.items()}
-        self.ast = {rel: ast.parse(text) for rel, text in self.text.items()}
-        self.new_layout = (self.package / GAP_SOURCES).is_dir()
-        self.modules = {module_name(rel): rel for rel in self.paths}
-
-    def where(self, rel: str) -> Optional[str]:
-        """A path of the layout by concept as this tree has it (None: not in this tree)."""
-        old = None if self.new_layout else OLD_PATHS.get(rel)
-        return rel if rel in self.paths else (old if old in self.paths else None)
-
-    def owned(self, rels) -> tuple[set[str], str]:
-        """The owners that this tree has, and a note naming those it has not."""
-        missing = [r for r in rels if self.where(r) is None]
-        return {self.where(r) for r in rels} - {None}, (
-            f"not in this tree: {', '.join(missing)}" if missing else "")
-
-    def in_gap_sources(self, rel: str) -> bool:
-        return rel.startswith(GAP_SOURCES) if self.new_layout else rel in {
-            old for new, old in OLD_PATHS.items() if new.startswith(GAP_SOURCES)}
-
-
 def existing_counts(tree: Tree) -> dict[str, Count]:
     """The counts of the first refactoring (docs/CONTACT_AXES.md), by the same rules."""
     long = {"modules over 400 lines": [], "classes over 200 lines": [],
@@ -325,118 +239,6 @@ def public_names(tree: Tree) -> dict[str, Count]:
         out[f"public names of {cls}"] = Count(len(public), public) if node else Count(
             None, note=f"no {cls} in {rel}")
     return out
-
-
-def imports(tree: Tree) -> list[tuple[str, str, int, int]]:
-    """(importer, imported module, kind: index in IMPORT_KINDS, line) of each package import."""
-    known = set(tree.modules) | EXTENSIONS
-    out = set()
-    for rel, module in tree.ast.items():
-        name = module_name(rel)
-        package = name if rel.endswith("__init__.py") else name.rpartition(".")[0]
-
-        def visit(node: ast.AST, kind: int) -> None:
-            if isinstance(node, ast.Import):
-                for alias in node.names:
-                    parts = alias.name.split(".")
-                    out.update((name, m, kind, node.lineno) for m in next((
-                        [".".join(parts[:n])] for n in range(len(parts), 0, -1)
-                        if ".".join(parts[:n]) in known), []))
-            elif isinstance(node, ast.ImportFrom):
-                base = node.module or ""
-                if node.level:
-                    parts = package.split(".")[:len(package.split(".")) - node.level + 1]
-                    base = ".".join(parts + [node.module] * bool(node.module))
-                for alias in node.names:
-                    target = f"{base}.{alias.name}" if f"{base}.{alias.name}" in known else base
-                    out.update([(name, target, kind, node.lineno)] if target in known else [])
-            elif isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
-                for child in node.body:
-                    visit(child, max(kind, 1))
-                for child in node.orelse:
-                    visit(child, kind)
-            else:
-                function = isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
-                for child in ast.iter_child_nodes(node):
-                    visit(child, 2 if function else kind)
-        visit(module, 0)
-    return sorted(edge for edge in out if edge[1] in tree.modules and edge[1] != edge[0])
-
-
-def components(graph: dict[str, set[str]]) -> list[list[str]]:
-    """The strongly connected components of more than one module: each module with those that
-    reach it among those it reaches (a search from each module; the package has ~100)."""
-    reach = {}
-    for v in graph:
-        seen, todo = set(), [v]
-        while todo:
-            todo.extend(graph.get(w := todo.pop(), set()) - seen)
-            seen.add(w)
-        reach[v] = seen
-    parts = {frozenset(w for w in reach[v] if v in reach.get(w, ())) | {v} for v in graph}
-    return sorted(sorted(part) for part in parts if len(part) > 1)
-
-
-def shortest_cycle(part: list[str], graph: dict[str, set[str]]) -> list[str]:
-    """A shortest cycle through the component's first module (a breadth-first search)."""
-    start, before = part[0], {part[0]: ""}
-    queue = [start]
-    for v in queue:
-        for w in sorted(graph[v] & set(part)):
-            if w == start:
-                path = [v]
-                while path[-1] != start:
-                    path.append(before[path[-1]])
-                return path[::-1] + [start]
-            if w not in before:
-                before[w] = v
-                queue.append(w)
-    return part
-
-
-def import_counts(tree: Tree) -> dict[str, Count]:
-    edges = imports(tree)
-    kind_of: dict[tuple[str, str], int] = {}
-    for a, b, kind, _ in edges:
-        kind_of[(a, b)] = min(kind, kind_of.get((a, b), kind))
-    out = {}
-    for level, label in enumerate(("module-level imports", "with type-hint imports",
-                                   "with type-hint and function-local imports")):
-        graph: dict[str, set[str]] = {}
-        for (a, b), kind in kind_of.items():
-            if kind <= level:
-                graph.setdefault(a, set()).add(b)
-        items = []
-        for part in components(graph):
-            path = shortest_cycle(part, graph)
-            marks = [" → " + (f"[{IMPORT_KINDS[kind_of[a, b]]}] " if kind_of[a, b] else "")
-                     + short(b) for a, b in zip(path, path[1:])]
-            rest = [short(m) for m in part if m not in path]
-            items.append(f"{len(part)} modules: {short(path[0])}{''.join(marks)}"
-                         + (f" (and {', '.join(rest)})" if rest else ""))
-        out[f"import cycles, {label}"] = Count(len(items), items)
-    subpackages = {rel.split("/")[1] for rel in tree.paths
-                   if re.fullmatch(r"contact/\w+/__init__\.py", rel)}
-    deep = sorted({f"{tree.modules[a]}:{line} {short(b)}" for a, b, _, line in edges
-                   for sub in subpackages if b.startswith(f"dolfinx_mortar.contact.{sub}.")
-                   and not a.startswith(f"dolfinx_mortar.contact.{sub}")})
-    out["imports past a contact subpackage's __init__"] = Count(
-        len(deep) if subpackages else None, deep,
-        "" if subpackages else "no subpackages of contact/")
-    return out
-
-
-def folder_counts(tree: Tree) -> dict[str, Count]:
-    sizes: dict[str, list[int]] = {}
-    for rel, text in tree.text.items():
-        folder = f"dolfinx_mortar/{rel.rpartition('/')[0]}/".replace("//", "/")
-        size = sizes.setdefault(folder, [0, 0])
-        size[0] += len(text.splitlines())
-        size[1] += 1
-    flagged = [f"{folder} ({lines} lines, {n} modules)" for folder, (lines, n)
-               in sorted(sizes.items()) if lines > FOLDER_LINES or n > FOLDER_MODULES]
-    return {f"folders over {FOLDER_LINES:,} lines or {FOLDER_MODULES} modules":
-            Count(len(flagged), flagged)}
 
 
 def kind_questions(tree: Tree) -> dict[str, Count]:

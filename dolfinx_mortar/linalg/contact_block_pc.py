@@ -26,7 +26,7 @@ rigid-body modes of each body) and ``contact_block_`` for the block's solver
 from __future__ import annotations
 
 import time
-from typing import Callable, Optional
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 from petsc4py import PETSc
@@ -52,19 +52,23 @@ class ContactBlockPreconditioner:
 
     Parameters
     ----------
-    contact_rows
-        Called at each setup: the global indices (this rank's owned rows) of
-        the rows that carry contact stiffness in the current operator.
     prefix
         The solver's options prefix; the multigrid reads ``<prefix>amg_…``, the
         block solver ``<prefix>contact_block_…``.
     near_nullspace
         Called once when the multigrid is GAMG: the rigid-body modes to attach.
+
+    Attributes
+    ----------
+    contact_rows
+        The global indices (this rank's owned rows) of the rows that carry
+        contact stiffness in the operator of the next set-up: given by the
+        Jacobian's assembly (:func:`tell_preconditioner`).
     """
 
-    def __init__(self, contact_rows: Callable[[], np.ndarray], prefix: str = "",
+    def __init__(self, prefix: str = "",
                  near_nullspace: Optional[Callable[[], PETSc.NullSpace]] = None):
-        self.contact_rows = contact_rows
+        self.contact_rows = np.zeros(0, dtype=PETSc.IntType)
         self.prefix = prefix
         self.near_nullspace = near_nullspace
         self.amg: Optional[PETSc.KSP] = None
@@ -91,7 +95,7 @@ class ContactBlockPreconditioner:
         self.amg.setUp()
         self._add("amg_setup", clock)
         clock = time.perf_counter()
-        rows = np.asarray(self.contact_rows(), dtype=PETSc.IntType)
+        rows = np.asarray(self.contact_rows, dtype=PETSc.IntType)
         if self.rows is not None:
             self.rows.destroy()
         self.rows = PETSc.IS().createGeneral(rows, comm=comm)
@@ -179,3 +183,21 @@ class ContactBlockPreconditioner:
 
     def _add(self, name: str, since: float) -> None:
         self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - since
+
+
+def tell_preconditioner(ksp: PETSc.KSP, stiffened_rows: Sequence[np.ndarray],
+                        pattern_changed: bool) -> None:
+    """What ``ksp``'s preconditioner needs to know of the Jacobian just
+    assembled for it: a new set-up (symbolic factorization, multigrid) where
+    the contact changed the matrix's pattern in a way PETSc does not notice
+    (:class:`~dolfinx_mortar.linalg.sparse_products.PatternTrackingAdd`), and,
+    for a :class:`ContactBlockPreconditioner`, the rows the contact terms
+    stiffened (one array per term)."""
+    pc = ksp.getPC()
+    if pattern_changed:
+        pc.reset()
+    if pc.getType() == "python":
+        context = pc.getPythonContext()
+        if isinstance(context, ContactBlockPreconditioner):
+            rows = list(stiffened_rows) or [np.zeros(0, dtype=PETSc.IntType)]
+            context.contact_rows = np.unique(np.concatenate(rows)).astype(PETSc.IntType)

@@ -11,7 +11,7 @@ weakly, so the modes are built per body.
 """
 from __future__ import annotations
 
-from typing import Optional
+from typing import Optional, Sequence
 
 import numpy as np
 import scipy.sparse
@@ -162,7 +162,6 @@ def _owned_node_coordinates(V: fem.FunctionSpace) -> np.ndarray:
     return x
 
 
-
 #: a rigid motion that a bulk matrix resists by less than this fraction of its
 #: own scale is free (only the contact can hold it)
 FREE_MOTION = 1e-6
@@ -202,3 +201,37 @@ def free_rigid_motions(A: PETSc.Mat, modes: list[PETSc.Vec],
             motion.axpy(ck, r)
         free.append(motion)
     return free
+
+
+class RigidModes:
+    """The rigid-body modes of the bodies of V's mesh, made on first use, and
+    those of them that a bulk matrix leaves free.
+
+    Parameters
+    ----------
+    V
+        The displacement's space (a vector Lagrange space).
+    """
+
+    def __init__(self, V: fem.FunctionSpace):
+        self._V = V
+        self._modes: Optional[PETSc.NullSpace] = None
+
+    def near_nullspace(self) -> PETSc.NullSpace:
+        """The modes as a near-nullspace (:func:`rigid_body_modes`), made once."""
+        if self._modes is None:
+            self._modes = rigid_body_modes(self._V)
+        return self._modes
+
+    def free_motions(self, A: PETSc.Mat, bcs: Sequence[fem.DirichletBC] = ()) -> list[PETSc.Vec]:
+        """The rigid motions that the bulk matrix ``A``, assembled with the
+        Dirichlet rows of ``bcs``, does not resist (:func:`free_rigid_motions`).
+        Collective."""
+        from dolfinx.fem import petsc as fem_petsc
+        V = self._V
+        free = ghosted_vector(V.dofmap.index_map, V.dofmap.index_map_bs)
+        free.set(1.0)
+        fem_petsc.set_bc(free, list(bcs), alpha=0.0)
+        motions = free_rigid_motions(A, list(self.near_nullspace().getVecs()), free.array_r)
+        free.destroy()
+        return motions

@@ -7,13 +7,12 @@ rigid obstacle's position (``obstacle.move_to``). Each step is solved by SNES
 ``petsc_options`` given); a step that fails is halved and retried (one
 warning through :mod:`logging` per cut-back, each recorded in
 :attr:`SolveResult.cut_backs`), cut steps regrow after successes, and after
-too many failures :class:`~dolfinx_mortar.solver.convergence.ContactDivergenceError`
-names every attempt's cause with its residual history. Converged steps go to XDMF.
+too many failures :class:`~dolfinx_mortar.solver.newton.convergence.ContactDivergenceError`
+names every attempt's cause with its residual history (:mod:`~dolfinx_mortar.solver.path_run`).
+Converged steps go to XDMF.
 """
 from __future__ import annotations
 
-import logging
-import math
 import time
 from pathlib import Path
 from typing import Callable, Optional, Union
@@ -22,21 +21,20 @@ import numpy as np
 from petsc4py import PETSc
 
 from dolfinx_mortar.input_checks import collective_checks, unused_petsc_options
-from dolfinx_mortar.io.contact_output import ContactOutput
-from dolfinx_mortar.solver.convergence import (ContactDivergenceError, EquilibriumTest,
-                                               FailedAttempt, describe_failure)
 from dolfinx_mortar.linalg.contact_block_pc import ContactBlockPreconditioner
 from dolfinx_mortar.linalg.linear_solver import (DIRECT_OPTIONS, choose_linear_solver,
                                                  iterative_options)
-from dolfinx_mortar.solver.line_search import FullStepFirst, library_line_search
+from dolfinx_mortar.linalg.near_nullspace import RigidModes
 from dolfinx_mortar.solver.load_stepping import LoadStepper
-from dolfinx_mortar.solver.newton_start import PathExtrapolation, close_gaps
-from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
-from dolfinx_mortar.solver.petsc_options import DEFAULT_OPTIONS, TemporaryOptions
-from dolfinx_mortar.solver.step_results import NewtonOutcome, SolveResult, StepResult
+from dolfinx_mortar.solver.newton import (EquilibriumTest, FullStepFirst, PathExtrapolation,
+                                          StepNewton)
+from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem, contact_matrix
+from dolfinx_mortar.solver.path_run import PathRun
+from dolfinx_mortar.solver.petsc_options import (DEFAULT_OPTIONS, TemporaryOptions,
+                                                 configure_contact_ksp, set_callbacks)
+from dolfinx_mortar.solver.step_results import SolveResult, StepResult
 
-logger = logging.getLogger(__name__)
-_SNES = PETSc.SNES.ConvergedReason
+__all__ = ["LoadPathSolver", "SolveResult", "StepResult"]
 
 
 class LoadPathSolver:
@@ -63,44 +61,52 @@ class LoadPathSolver:
     def __init__(self, problem: NonlinearContactProblem,
                  petsc_options: Optional[dict] = None, prefix: str = "dolfinx_mortar_",
                  linear_solver: str = "auto"):
+        #: the problem solved
         self.problem = problem
+        #: the options prefix
         self.prefix = prefix
-        augmented = any(term.traits.takes_the_linear_solve for term in problem.contacts)
-        gdim = problem.u.function_space.mesh.geometry.dim
+        traits = [term.traits for term in problem.contacts]
+        self._two_phases = any(t.follows_u for t in traits)
+        self._symmetric = all(t.symmetric for t in traits)
+        V = problem.u.function_space
+        num_dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
         #: "direct" or "iterative", as chosen for this problem
-        self.linear_solver = choose_linear_solver(linear_solver, problem.num_dofs, gdim,
-                                                  augmented)
-        #: the iterative path's preconditioner, once made
-        self.preconditioner: Optional[ContactBlockPreconditioner] = None
+        self.linear_solver = choose_linear_solver(
+            linear_solver, num_dofs, V.mesh.geometry.dim,
+            any(t.takes_the_linear_solve for t in traits))
+        #: this solver's PETSc options (without the prefix)
         self.petsc_options = dict(petsc_options or {})
-        self.comm = problem.u.function_space.mesh.comm
-        self.equilibrium = EquilibriumTest()
+        self._comm = V.mesh.comm
+        self._equilibrium = EquilibriumTest()
+        self._rigid_modes = RigidModes(V)
+        # the iterative path's preconditioner, once made
+        self._preconditioner: Optional[ContactBlockPreconditioner] = None
+        # the Jacobian matrix of the SNES (made again when the contact pattern changes)
+        self._A: Optional[PETSc.Mat] = None
+        self._gamg = False
         self._options_checked = False
-        #: which options the user set in the database when solve() began
+        # which options the user set in the database when solve() began
         self._user_options: dict[str, bool] = {}
         #: wall time (s) inside SNES solves, callbacks included (accumulated)
         self.timings: dict[str, float] = {}
-        #: the line search of the last :meth:`create_snes` (None where the user
-        #: chose one: :meth:`library_line_search`)
+        #: the library's line search on the SNES of the last :meth:`create_snes`
+        #: (the problem's, :attr:`NonlinearContactProblem.line_search`), None
+        #: where the options choose another (``snes_linesearch_type``)
         self.line_search: Optional[FullStepFirst] = None
-
-    @property
-    def contacts(self):
-        return self.problem.contacts
 
     def default_options(self) -> dict:
         """The solver's defaults (:data:`DEFAULT_OPTIONS`), with the iterative
         linear solver's options where it was chosen.
 
         The line search is ``basic`` with
-        :class:`~dolfinx_mortar.solver.line_search.FullStepFirst` as its
-        pre-check, unless the user chose a line search (:meth:`library_line_search`).
+        :class:`~dolfinx_mortar.solver.newton.line_search.FullStepFirst` as its
+        pre-check, unless the user chose a line search (``snes_linesearch_type``).
         """
         defaults = dict(DEFAULT_OPTIONS)
         if self.linear_solver == "iterative":
             for key in DIRECT_OPTIONS:
                 defaults.pop(key)
-            defaults.update(iterative_options(self.problem.symmetric))
+            defaults.update(iterative_options(self._symmetric))
         return defaults
 
     def options(self) -> TemporaryOptions:
@@ -116,70 +122,47 @@ class LoadPathSolver:
 
     def create_snes(self) -> PETSc.SNES:
         """A SNES with the problem's callbacks, configured from the options
-        database (inside :meth:`options` for this solver's own)."""
-        snes = PETSc.SNES().create(self.comm)
+        database (inside :meth:`options` for this solver's own): what
+        :meth:`solve` solves each load step with."""
+        snes = PETSc.SNES().create(self._comm)
         snes.setOptionsPrefix(self.prefix)
-        self.problem.configure_snes(snes)
+        set_callbacks(snes, self.problem, self._matrix())
         snes.setConvergenceHistory()
-        self._configure_from_options(snes)
-        self.line_search = (library_line_search(self.problem, snes)
-                            if self.library_line_search() else None)
+        snes.setFromOptions()
+        snes.setConvergenceTest(self._equilibrium)
+        self._configure_preconditioner(snes.getKSP())
+        configure_contact_ksp(snes.getKSP(), self.problem.contacts)
+        key = "snes_linesearch_type"
+        chosen = key in self.petsc_options or self._user_options.get(key, False)
+        self.line_search = None if chosen else self.problem.line_search
+        if self.line_search is not None:
+            self.line_search.attach(snes)
         return snes
 
-    def _configure_from_options(self, snes: PETSc.SNES) -> None:
-        """Read the options database into ``snes``, then put back what the
-        solver sets in code (the convergence test, the preconditioners)."""
-        snes.setFromOptions()
-        snes.setConvergenceTest(self.equilibrium)
-        self._configure_preconditioner(snes.getKSP())
-        self.problem.configure_ksp(snes.getKSP())
-
-    def library_line_search(self) -> bool:
-        """Whether the library's line search
-        (:class:`~dolfinx_mortar.solver.line_search.FullStepFirst`) runs: the
-        user set no ``snes_linesearch_type``.
-
-        It halves steps whose residual is not finite (a finite-strain law past
-        J = 0) in every phase, and shortens full steps that do not lower
-        ``‖F‖`` to ``l2``'s length on the current surface (the second phase of
-        a ``"current"`` step) and, for a bulk law that is nonlinear in u, in
-        every phase (:attr:`shortens_frozen_steps`).
-        """
-        key = "snes_linesearch_type"
-        return not (key in self.petsc_options or self._user_options.get(key, False))
-
-    @property
-    def shortens_frozen_steps(self) -> bool:
-        """Whether the line search shortens steps on frozen surfaces too: the
-        bulk residual is nonlinear in u.
-
-        A frozen surface is the piecewise-linear "previous" model. With a
-        linear bulk, shortened steps only slowed the active set down (Newton
-        iterations, full steps against shortened ones: Hertz 2D 22 against 28,
-        with an elastic block 23/33, Hertz 3D 16/24); a neo-Hookean bulk
-        needs them (a disk pressed into a block and slid sideways, 12 steps
-        requested: 12 steps and no cut-back against 24 steps and 7
-        cut-backs; ironing 2D 800 against 1387 Newton iterations).
-        """
-        return not self.problem.bulk_is_linear
-
-    @property
-    def current(self) -> bool:
-        """Whether a contact term uses the current configuration (two phases per step)."""
-        return self.problem.current
+    def _matrix(self, new: bool = False) -> PETSc.Mat:
+        """The SNES's Jacobian matrix (``new``: made again, the contact pattern
+        changed), with the rigid-body modes where GAMG needs them."""
+        if new and self._A is not None:
+            self._A.destroy()
+            self._A = None
+        if self._A is None:
+            self._A = contact_matrix(self.problem.a, self.problem.bcs, self.problem.contacts)
+            if self._gamg:
+                self._A.setNearNullSpace(self._rigid_modes.near_nullspace())
+        return self._A
 
     def _configure_preconditioner(self, ksp: PETSc.KSP) -> None:
         """The contact-block preconditioner for ``pc_type python`` (the
         iterative default) and the rigid-body modes for multigrid."""
         pc = ksp.getPC()
         if pc.getType() == "gamg":
-            self.problem.attach_near_nullspace = True
-            self.problem.matrix().setNearNullSpace(self.problem.near_nullspace())
+            self._gamg = True
+            self._matrix().setNearNullSpace(self._rigid_modes.near_nullspace())
         if pc.getType() == "python" and self.linear_solver == "iterative":
-            if self.preconditioner is None:
-                self.preconditioner = ContactBlockPreconditioner(
-                    self.problem.contact_rows, self.prefix, self.problem.near_nullspace)
-            pc.setPythonContext(self.preconditioner)
+            if self._preconditioner is None:
+                self._preconditioner = ContactBlockPreconditioner(
+                    self.prefix, self._rigid_modes.near_nullspace)
+            pc.setPythonContext(self._preconditioner)
 
     def solve(self, update: Callable[[float], None], load_steps: int = 1,
               output: Optional[Union[str, Path]] = None, max_cuts: int = 5,
@@ -212,183 +195,93 @@ class LoadPathSolver:
         if predictor not in ("none", "linear"):
             raise ValueError(f"predictor must be 'none' or 'linear', not {predictor!r}")
         stepper = LoadStepper(load_steps, max_cuts)
-        self.equilibrium.force_scale = 0.0
+        self._equilibrium.force_scale = 0.0
         u = self.problem.u
-        with collective_checks(self.comm):
+        with collective_checks(self._comm):
             if not np.all(np.isfinite(u.x.array)):
                 raise ValueError("the displacement contains NaN or infinite values")
-        writer = ContactOutput(Path(output), u, self.contacts) if output is not None else None
-        result = SolveResult()
-        failures: list[FailedAttempt] = []
-        # each term's deepest penetration over the converged steps (warned about at the end)
-        deepest = [(-np.inf, 0.0, [])] * len(self.contacts)
+        run = PathRun(self.problem.contacts, u, stepper, output, progress, on_step)
         path = PathExtrapolation() if predictor == "linear" else None
-        bar = None
-        if progress and self.comm.rank == 0:
-            from tqdm import tqdm
-            bar = tqdm(total=stepper.load_steps, desc="load steps", unit="step")
-        db = PETSc.Options()
-        self._user_options = {"snes_linesearch_type":
-                              db.hasName(self.prefix + "snes_linesearch_type")}
+        self._user_options = {"snes_linesearch_type": PETSc.Options().hasName(
+            self.prefix + "snes_linesearch_type")}
         with self.options():
             self._options_checked = False
             snes = self.create_snes()
+            newton = StepNewton(self.problem, self._equilibrium, self.line_search,
+                                self._two_phases, self.timings)
             try:
                 while not stepper.done:
-                    target = stepper.target()
-                    update(target)
-                    if any([term.begin_step() for term in self.contacts]):
-                        snes.setJacobian(lambda _s, x, A, P: self.problem.J(x, A, _s.getKSP()),
-                                         self.problem.refresh_matrix())
-                    saved = u.x.petsc_vec.copy()
-                    clock = time.perf_counter()
-                    x = u.x.petsc_vec.copy()
-                    increment = path.increment(target) if path is not None else None
-                    outcome = self.newton_step(snes, x, increment)
-                    if not outcome.converged:
-                        attempt = FailedAttempt(target, outcome.reason, outcome.residuals,
-                                                outcome.cause)
-                        failures.append(attempt)
-                        stepper.failed()
-                        if stepper.exhausted:
-                            raise ContactDivergenceError(target, failures)
-                        result.cut_backs.append(attempt)
-                        if self.comm.rank == 0:
-                            logger.warning("load step to t = %.6g failed after %d Newton "
-                                           "iterations (%s); cut back to t = %.6g",
-                                           target, outcome.iterations, outcome.cause,
-                                           stepper.target())
-                        saved.copy(u.x.petsc_vec)
-                        u.x.scatter_forward()
-                        continue
-                    failures = []
-                    x.copy(u.x.petsc_vec)
-                    u.x.scatter_forward()
-                    states = [term.evaluate() for term in self.contacts]
-                    if any([term.widen_search_radius(state)
-                            for term, state in zip(self.contacts, states)]):
-                        # the bases were cut off by the search radius: the same step again
-                        saved.copy(u.x.petsc_vec)
-                        u.x.scatter_forward()
-                        snes.setJacobian(lambda _s, x, A, P: self.problem.J(x, A, _s.getKSP()),
-                                         self.problem.refresh_matrix())
-                        continue
-                    for term, state in zip(self.contacts, states):
-                        term.accept_step(state)
-                    if path is not None:
-                        path.converged(target, u.x.petsc_vec)
-                    deepest = [max(worst, term.results.penetration(state), key=lambda d: d[0])
-                               for worst, term, state in zip(deepest, self.contacts, states)]
-                    active = sum(t.results.active_nodes(s) for t, s in zip(self.contacts, states))
-                    step = StepResult(target, outcome.iterations, outcome.residuals,
-                                      time.perf_counter() - clock, active, outcome.phases,
-                                      outcome.reference, outcome.linear_iterations,
-                                      [t.results.friction_summary(s)
-                                       for t, s in zip(self.contacts, states)])
-                    result.steps.append(step)
-                    before = stepper.fraction_of_steps
-                    stepper.succeeded()
-                    if bar is not None:
-                        bar.update(stepper.fraction_of_steps - before)
-                    if writer is not None:
-                        writer.write(target, states)
-                    if on_step is not None:
-                        on_step(step)
-                for term, worst in zip(self.contacts, deepest):
-                    term.check_path(worst)
+                    self._attempt(snes, newton, update, stepper.target(), run, path)
+                run.end()
             finally:
-                if bar is not None:
-                    bar.close()
+                run.close()
                 snes.destroy()
-        return result
+        return run.result
 
-    def newton_step(self, snes: PETSc.SNES, x: PETSc.Vec,
-                    increment: Optional[PETSc.Vec] = None) -> NewtonOutcome:
-        """One load step's Newton solve from x (plus a predictor's ``increment``).
+    def _attempt(self, snes: PETSc.SNES, newton: StepNewton, update: Callable[[float], None],
+                 target: float, run: PathRun, path: Optional[PathExtrapolation]) -> None:
+        """One attempt at the load step to ``target``: converged and accepted,
+        solved again (a wider search radius), or cut back."""
+        update(target)
+        if any([term.begin_step() for term in self.problem.contacts]):
+            # the bases were rebuilt: the contact pattern may have changed
+            set_callbacks(snes, self.problem, self._matrix(new=True))
+        u = self.problem.u
+        saved = u.x.petsc_vec.copy()
+        clock = time.perf_counter()
+        x = u.x.petsc_vec.copy()
+        increment = path.increment(target) if path is not None else None
+        try:
+            outcome = newton.solve(snes, x, self._A, increment)
+            self._check_petsc_options_once()
+            if not outcome.converged:
+                run.failed(target, outcome)
+                _restore(u, saved)
+                return
+            states = self._accepted(snes, x, saved)
+            if states is None:
+                return
+            if path is not None:
+                path.converged(target, u.x.petsc_vec)
+            run.converged(target, outcome, states, time.perf_counter() - clock)
+        finally:
+            for vector in (saved, x, increment):
+                if vector is not None:
+                    vector.destroy()
 
-        The step is accepted when ``‖R‖ ≤ rtol·F``
-        (:class:`~dolfinx_mortar.solver.convergence.EquilibriumTest`) with F the
-        residual norm at x before the gap-closing start: the force out of
-        balance when the step starts, whatever Newton starts from.
+    def _accepted(self, snes: PETSc.SNES, x: PETSc.Vec, saved: PETSc.Vec) -> Optional[list]:
+        """The converged ``x`` made u, and the contact states at it, one per
+        term; or None: a term widened its search radius (the bases were cut
+        off by it), u is back at ``saved`` and the step must be solved again."""
+        u = self.problem.u
+        x.copy(u.x.petsc_vec)
+        u.x.scatter_forward()
+        contacts = self.problem.contacts
+        states = [term.evaluate() for term in contacts]
+        if any([term.widen_search_radius(state) for term, state in zip(contacts, states)]):
+            _restore(u, saved)
+            set_callbacks(snes, self.problem, self._matrix(new=True))
+            return None
+        for term, state in zip(contacts, states):
+            term.accept_step(state)
+        return states
 
-        With ``basis_configuration="current"`` the step is first solved with
-        the surface frozen where the step starts (the "previous" model:
-        piecewise linear, robust), then on the current surface with the exact
-        Jacobian. Started from the current surface directly, the first
-        iterations overshoot to pressures whose geometric stiffness is larger
-        than the bulk's, and Newton cycled or diverged (Hertz 2D).
-        """
-        phases: list = []
-        iterations = linear = 0
-        b = self.problem.vector()
-        self.problem.F(x, b)
-        reference = self.equilibrium.step_reference(b.norm())
-        self.equilibrium.start(reference, self.problem.carried_force())
-        if increment is not None:
-            x.axpy(1.0, increment)
-            self.problem.F(x, b)
-            if not math.isfinite(b.norm()):
-                # the extrapolation left the law's domain (J ≤ 0 under ln J) or
-                # collapsed a surface: start from the last converged state
-                x.axpy(-1.0, increment)
-            elif not self.current:
-                # the gap-closing start evaluates the same model at the same x
-                # (with "current" it runs on the frozen surface: another residual)
-                self.problem.offer_residual(x, b)
-        for frozen in ([True, False] if self.current else [False]):
-            reason = self._solve_phase(snes, x, frozen)
-            phases.append([float(r) for r in snes.getConvergenceHistory()[0]])
-            iterations += snes.getIterationNumber()
-            linear += snes.getLinearSolveIterations()
-            if reason <= 0:
-                cause = describe_failure(snes, self.equilibrium, self.problem.evaluation_error)
-                if self.equilibrium.cause is not None or reason == _SNES.DIVERGED_MAX_IT:
-                    # Newton ran and got nowhere (not a failed linear solve or residual)
-                    cause += self._contact_hint()
-                return NewtonOutcome(reason, phases, iterations, cause, reference, linear)
-        return NewtonOutcome(reason, phases, iterations, "", reference, linear)
-
-    def _contact_hint(self) -> str:
-        """What the contact says about a failed Newton solve, from its state at
-        the last iterate: nothing touching means a body that only the contact
-        holds has no stiffness (collective)."""
-        if self.problem.evaluation_error is not None:
-            return ""
-        # u holds the last iterate; the frozen phase's states are gone with its model
-        states = [term.state if term.state is not None else term.evaluate()
-                  for term in self.contacts]
-        if sum(term.results.active_nodes(state) for term, state in zip(self.contacts, states)) > 0:
-            return ""
-        return ("; no slave node was in contact at the last iterate: if only the contact "
-                "holds the body, the load pulls it away from the master or obstacle, or "
-                "nothing is within reach (check the load's sign, which surface is the "
-                "slave and which the master, and the obstacle's position)")
-
-    def _solve_phase(self, snes: PETSc.SNES, x: PETSc.Vec, frozen: bool) -> int:
-        from contextlib import ExitStack
-        with ExitStack() as stack:
-            if frozen:
-                for term in self.contacts:
-                    stack.enter_context(term.frozen())
-            if frozen and self.line_search is not None and not self.shortens_frozen_steps:
-                stack.enter_context(self.line_search.full_steps_only())
-            close_gaps(self.problem, snes.getKSP(), x)
-            snes.setConvergenceHistory(reset=True)
-            clock = time.perf_counter()
-            snes.solve(None, x)
-            self.timings["snes_solve"] = (self.timings.get("snes_solve", 0.0)
-                                          + time.perf_counter() - clock)
-        if not self._options_checked:
-            # every option is read by the first solve: once per solve() is enough
-            self._check_petsc_options()
-            self._options_checked = True
-        return snes.getConvergedReason()
-
-    def _check_petsc_options(self) -> None:
-        """Refuse options under the prefix that no PETSc object read (misspelled)."""
+    def _check_petsc_options_once(self) -> None:
+        """Refuse options under the prefix that no PETSc object read
+        (misspelled), once per :meth:`solve`: every option is read by its
+        first SNES solve."""
+        if self._options_checked:
+            return
+        self._options_checked = True
         unused = unused_petsc_options(self.prefix,
                                       ignore={**DEFAULT_OPTIONS, **iterative_options(True)})
         if unused:
             raise ValueError(f"PETSc option(s) {', '.join(unused)} were set but not used by "
                              f"any solver of this problem: misspelled, or meant for another "
                              f"prefix? (options prefix '{self.prefix}')")
+
+
+def _restore(u, saved: PETSc.Vec) -> None:
+    """u back at ``saved`` (a failed or repeated step)."""
+    saved.copy(u.x.petsc_vec)
+    u.x.scatter_forward()

@@ -1,4 +1,5 @@
-"""The solver's default PETSc options and options given per solver.
+"""A SNES's set-up: the default PETSc options, options given per solver, the
+problem's callbacks and what the contact terms need of the linear solver.
 
 The defaults are set under the prefix unless the options database has them
 (so the command line wins); options given to a solver
@@ -7,7 +8,7 @@ solve, so that they do not leak into the next solver with the same prefix.
 """
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any, Mapping, Optional, Protocol, Sequence
 
 from petsc4py import PETSc
 
@@ -18,7 +19,7 @@ DEFAULT_OPTIONS = {
     "snes_type": "newtonls",
     "snes_linesearch_type": "basic",
     # relative to the out-of-balance force where the step starts
-    # (dolfinx_mortar.solver.convergence.EquilibriumTest)
+    # (dolfinx_mortar.solver.newton.convergence.EquilibriumTest)
     "snes_rtol": 1e-11,
     # absolute residuals depend on the units: rely on the relative test
     "snes_atol": 1e-15,
@@ -69,3 +70,31 @@ class TemporaryOptions:
             else:
                 db[name] = old
         self._saved = {}
+
+
+class Callbacks(Protocol):
+    """What a SNES calls of a problem
+    (:class:`~dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem`)."""
+
+    def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        """The residual at ``x`` into ``b``."""
+
+    def J(self, x: PETSc.Vec, A: PETSc.Mat, ksp: Optional[PETSc.KSP] = None) -> None:
+        """The Jacobian at ``x`` into ``A`` (``ksp``: the solver that will use it)."""
+
+    def vector(self) -> PETSc.Vec:
+        """The residual vector."""
+
+
+def set_callbacks(snes: PETSc.SNES, problem: Callbacks, A: PETSc.Mat) -> None:
+    """Give ``snes`` the problem's residual and Jacobian, with ``A`` (a matrix
+    with the contact pattern) as its Jacobian matrix."""
+    snes.setFunction(lambda _snes, x, b: problem.F(x, b), problem.vector())
+    snes.setJacobian(lambda _snes, x, J, P: problem.J(x, J, _snes.getKSP()), A)
+
+
+def configure_contact_ksp(ksp: PETSc.KSP, contacts: Sequence) -> None:
+    """What the contact terms need of the linear solver (GLS kinds: the exact
+    augmented step as a python PC); call after ``setFromOptions``."""
+    for term in contacts:
+        term.configure_ksp(ksp)

@@ -5,34 +5,6 @@ from dataclasses import dataclass, field
 
 
 @dataclass
-class NewtonOutcome:
-    """How one load step's Newton solve ended
-    (:meth:`~dolfinx_mortar.solver.load_path.LoadPathSolver.newton_step`)."""
-
-    #: the SNES converged reason of the last solve (> 0: converged)
-    reason: int
-    #: residual norms per SNES solve (two with ``"current"``: frozen, then current surface)
-    phases: list
-    #: Newton iterations over all phases
-    iterations: int
-    #: what stopped it, in words ("" when it converged)
-    cause: str
-    #: the step's force scale F (the out-of-balance force where it started)
-    reference: float
-    #: Krylov iterations of its linear solves
-    linear_iterations: int
-
-    @property
-    def converged(self) -> bool:
-        return self.reason > 0
-
-    @property
-    def residuals(self) -> list:
-        """Residual norms of every Newton iterate, the phases one after another."""
-        return [r for phase in self.phases for r in phase]
-
-
-@dataclass
 class StepResult:
     """One converged load step."""
 
@@ -45,7 +17,7 @@ class StepResult:
     #: the same norms per SNES solve (two with ``"current"``: frozen surface, then current)
     phases: list = field(default_factory=list)
     #: the step's force scale F: the out-of-balance force where it started
-    #: (:class:`~dolfinx_mortar.solver.convergence.EquilibriumTest`)
+    #: (:class:`~dolfinx_mortar.solver.newton.convergence.EquilibriumTest`)
     reference: float = float("nan")
     #: Krylov iterations of the step's linear solves (1 per Newton iteration with LU)
     linear_iterations: int = 0
@@ -74,7 +46,7 @@ class SolveResult:
     """All converged steps, and every attempt that failed and was cut back."""
 
     steps: list = field(default_factory=list)
-    #: one :class:`~dolfinx_mortar.solver.convergence.FailedAttempt` (load
+    #: one :class:`~dolfinx_mortar.solver.newton.convergence.FailedAttempt` (load
     #: factor, SNES reason, residual norms, cause in words) per failed attempt
     #: after which the step was halved and retried, in the order they happened
     cut_backs: list = field(default_factory=list)

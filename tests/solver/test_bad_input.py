@@ -14,7 +14,7 @@ from dolfinx_mortar.kinds import kind_name, parse_kind
 from dolfinx_mortar.contact.obstacles import RigidPlane
 from dolfinx_mortar import (ContactProblem, ContactTerm, LoadPathSolver,
                             NonlinearContactProblem)
-from dolfinx_mortar.solver.convergence import ContactDivergenceError
+from dolfinx_mortar import ContactDivergenceError
 from support.meshes import rectangle
 
 PLANE = RigidPlane([0, 0], [0, 1])

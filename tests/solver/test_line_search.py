@@ -14,7 +14,7 @@ from support import load_demo
 from support.meshes import rectangle
 
 from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidSphere
-from dolfinx_mortar.solver.line_search import FullStepFirst, l2_step_length
+from dolfinx_mortar.solver.newton.line_search import FullStepFirst, l2_step_length
 
 BOTTOM, TOP, LEFT = 1, 2, 3
 
@@ -37,15 +37,24 @@ def test_l2_step_length_keeps_petscs_safeguards():
 class ArctanProblem:
     """F(x) = arctan(x) per entry: Newton from |x| > 1.39 overshoots, so the
     full step raises ‖F‖ there; near the root it converges quadratically.
-    The callbacks FullStepFirst uses, as NonlinearContactProblem has them."""
+    The callbacks FullStepFirst uses, as NonlinearContactProblem has them:
+    ``F`` takes the line search's offer first."""
 
     def __init__(self, n: int):
         self._b = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
         self.evaluations = 0
+        #: offers of the line search that F took instead of evaluating
         self.offers = 0
+        self.line_search = None
 
     def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        if self.line_search is not None and self.line_search.take_offer(x, b):
+            self.offers += 1
+            return
         self.evaluations += 1
+        self.evaluate(x, b)
+
+    def evaluate(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
         b.array[:] = np.arctan(x.array_r)
 
     def derivative(self, x: np.ndarray) -> np.ndarray:
@@ -54,8 +63,11 @@ class ArctanProblem:
     def vector(self) -> PETSc.Vec:
         return self._b
 
-    def offer_residual(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
-        self.offers += 1
+    def attach(self, snes: PETSc.SNES, shorten: bool = True) -> FullStepFirst:
+        """The library's line search on ``snes``, its offers taken by F."""
+        self.line_search = FullStepFirst(self, shorten=shorten)
+        self.line_search.attach(snes)
+        return self.line_search
 
     def snes(self, line_search: str) -> PETSc.SNES:
         snes = PETSc.SNES().create(PETSc.COMM_SELF)
@@ -101,8 +113,7 @@ def test_cut_steps_are_petscs_l2_steps_and_other_steps_are_full():
 
     problem = ArctanProblem(2)
     snes = problem.snes("basic")
-    line_search = FullStepFirst(problem, snes)
-    line_search.attach()
+    line_search = problem.attach(snes)
     xs = iterates(snes, x0, 4)
     assert np.allclose(xs[0], l2, rtol=1e-14, atol=1e-15)
     assert line_search.cut_steps == 1
@@ -120,8 +131,7 @@ def test_full_steps_only_takes_the_full_step_where_it_raises_the_residual():
     """The frozen phase of a linear bulk: full steps, also where ‖F‖ rises."""
     problem = ArctanProblem(2)
     snes = problem.snes("basic")
-    line_search = FullStepFirst(problem, snes)
-    line_search.attach()
+    line_search = problem.attach(snes)
     x0 = np.array([2.0, 0.1])
     with line_search.full_steps_only():
         x1 = iterates(snes, x0, 1)[0]
@@ -134,8 +144,7 @@ class LogProblem(ArctanProblem):
     """F(x) = ln(x) per entry, NaN for x ≤ 0 (a law with ln J): Newton's
     step from x is x ln x, which leaves the domain from x > e."""
 
-    def F(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
-        self.evaluations += 1
+    def evaluate(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
         with np.errstate(invalid="ignore", divide="ignore"):
             b.array[:] = np.where(x.array_r > 0, np.log(np.abs(x.array_r)), np.nan)
 
@@ -156,8 +165,7 @@ def test_a_step_to_a_residual_that_is_not_finite_is_halved_until_it_is(shorten):
 
     problem = LogProblem(1)
     snes = problem.snes("basic")
-    line_search = FullStepFirst(problem, snes, shorten=shorten)
-    line_search.attach()
+    line_search = problem.attach(snes, shorten=shorten)
     x1 = iterates(snes, np.array([5.0]), 1)[0]
     assert x1[0] == pytest.approx(5.0 - 0.5 * 5.0 * np.log(5.0), rel=1e-15)
     assert line_search.halved_steps == 1 and problem.offers == 1
@@ -204,7 +212,7 @@ def test_an_offered_residual_is_used_once_and_only_at_its_point():
     problem.F(x, fresh)
     before = contact.evaluations
 
-    problem.offer_residual(x, fresh)
+    problem.line_search.offer(x, fresh)
     problem.F(x, b)                       # the offer: copied, no evaluation
     assert contact.evaluations == before
     assert np.array_equal(b.array_r, fresh.array_r)
@@ -217,7 +225,7 @@ def test_an_offered_residual_is_used_once_and_only_at_its_point():
     fem.petsc.set_bc(y, problem.bcs)
     at_y = problem.vector().duplicate()
     problem.F(y, at_y)
-    problem.offer_residual(x, fresh)
+    problem.line_search.offer(x, fresh)
     problem.F(y, b)                       # not the offer's point: assembled
     assert contact.evaluations == before + 3
     assert np.array_equal(b.array_r, at_y.array_r)
@@ -235,23 +243,26 @@ def test_current_surface_steps_cost_one_residual_when_taken_whole():
     x0 = problem.u.x.petsc_vec.copy()
     push.value = -0.025
     solutions, counts = [], []
+    line_search = problem.line_search
     for options in ({}, {"snes_linesearch_type": "l2"}):
         solver = LoadPathSolver(problem, petsc_options=options)
         with solver.options():
             snes = solver.create_snes()
             x = x0.copy()
             before = contact.evaluations
+            steps = (line_search.full_steps, line_search.cut_steps)
             snes.solve(None, x)
             assert snes.getConvergedReason() > 0
             counts.append((contact.evaluations - before, snes.getIterationNumber(),
-                           solver.line_search))
+                           solver.line_search, line_search.full_steps - steps[0],
+                           line_search.cut_steps - steps[1]))
             solutions.append(x.array_r.copy())
             snes.destroy()
-    (ours, iterations, line_search), (theirs, l2_iterations, none) = counts
-    assert none is None
-    assert line_search.full_steps + line_search.cut_steps == iterations
-    assert line_search.full_steps >= 2
-    assert ours == 1 + line_search.full_steps + 3 * line_search.cut_steps
+    (ours, iterations, attached, full, cut), (theirs, l2_iterations, none, *l2_steps) = counts
+    assert attached is line_search and none is None and l2_steps == [0, 0]
+    assert full + cut == iterations
+    assert full >= 2
+    assert ours == 1 + full + 3 * cut
     assert theirs == 1 + 3 * l2_iterations
     comm = MPI.COMM_WORLD
     norm = np.sqrt(comm.allreduce(np.sum(solutions[1] ** 2)))
@@ -288,14 +299,16 @@ def test_a_linear_bulk_keeps_full_frozen_steps_and_a_nonlinear_one_shortens_them
     u, v = problem.u, ufl.TestFunction(V)
     linear = NonlinearContactProblem(ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx, u,
                                      contact, problem.bcs)
-    assert not problem.bulk_is_linear and linear.bulk_is_linear
     for bulk, frozen_shortens in ((problem, True), (linear, False)):
         solver = LoadPathSolver(bulk)
-        assert solver.shortens_frozen_steps == frozen_shortens
         with solver.options():
             snes = solver.create_snes()
             line_search = solver.line_search
+            assert line_search is bulk.line_search
+            assert line_search.shortens_frozen_steps == frozen_shortens
             assert line_search.shorten == (frozen_shortens or configuration == "current")
+            with line_search.frozen_phase():
+                assert line_search.shorten == frozen_shortens
             with line_search.full_steps_only():
                 assert not line_search.shorten
             snes.destroy()
@@ -325,9 +338,13 @@ def test_the_problems_own_snes_takes_the_library_line_search_unless_one_is_chose
     push.value = -0.01
     assert problem.solve() is problem.u
     assert problem.solver.getConvergedReason() > 0
-    assert problem.line_search is not None and problem.line_search.shorten
+    assert problem.line_search.shorten
     assert problem.line_search.full_steps + problem.line_search.cut_steps >= 1
     chosen = NonlinearContactProblem(neo_hookean_residual(problem.u, 1.0, 0.3), problem.u,
                                      contact, problem.bcs,
                                      petsc_options={"snes_linesearch_type": "bt"})
-    assert chosen.solver is not None and chosen.line_search is None
+    problem.u.x.array[:] = 0.0
+    assert chosen.solve() is problem.u
+    assert chosen.solver.getConvergedReason() > 0
+    unused = chosen.line_search
+    assert unused.full_steps + unused.cut_steps + unused.halved_steps == 0

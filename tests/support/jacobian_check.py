@@ -61,7 +61,8 @@ def newton_step_error(problem, rng_seed: int = 2, size: float = 1e-6) -> float:
     du = r.duplicate()
     ksp = PETSc.KSP().create(problem.mesh.comm)
     ksp.setOperators(J)
-    problem.problem.configure_ksp(ksp)    # the exact step of the augmented system
+    for term in problem.problem.contacts:    # the exact step of the augmented system
+        term.configure_ksp(ksp)
     ksp.solve(r, du)
     ksp.destroy()
     fd = residual_difference(problem, x0, du, size)

@@ -19,12 +19,15 @@ TOOL = Path(__file__).resolve().parents[2] / "tools" / "architecture_counts.py"
 
 @pytest.fixture(scope="module")
 def tool():
+    # the tool's modules import each other as a script's siblings
+    sys.path.insert(0, str(TOOL.parent))
     spec = importlib.util.spec_from_file_location("architecture_counts", TOOL)
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module        # dataclasses look their module up by name
     spec.loader.exec_module(module)
     yield module
     del sys.modules[spec.name]
+    sys.path.remove(str(TOOL.parent))
 
 
 def write(root: Path, files: dict[str, str]) -> Path:

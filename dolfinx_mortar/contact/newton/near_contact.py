@@ -77,8 +77,8 @@ class NearContactStiffness:
 
     Which of the two holds is decided from the bulk, not guessed: the rigid
     motions of the bodies that neither the Dirichlet conditions nor the
-    user's form resist (``free``, :meth:`NonlinearContactProblem.free_rigid_motions
-    <dolfinx_mortar.solver.nonlinear_problem.NonlinearContactProblem.free_rigid_motions>`)
+    user's form resist (``free``, :meth:`RigidModes.free_motions
+    <dolfinx_mortar.linalg.near_nullspace.RigidModes.free_motions>`)
     are the ones the contact must hold; from the second Newton Jacobian in
     a row at which nothing penetrates (:meth:`due`), the near nodes are
     stiffened only if one of them changes their gaps. The decision holds

@@ -2,9 +2,11 @@
 
 DOLFINx 0.9's ``dolfinx.nls.petsc.NewtonSolver(comm, problem)`` makes its
 Jacobian matrix from the bulk form alone; the contact stiffness needs a
-matrix with the contact's pattern too (:meth:`NonlinearContactProblem.matrix`).
-This subclass hands it that matrix, so that code written for the 0.9-style
-path runs as it is::
+matrix with the contact's pattern too (:meth:`NonlinearContactProblem.matrix`),
+and the GLS kinds their exact augmented step in the linear solver
+(:meth:`ContactTerm.configure_ksp <dolfinx_mortar.contact.term.ContactTerm.configure_ksp>`).
+This subclass sees to both, so that code written for the 0.9-style path runs
+as it is::
 
     problem = NonlinearContactProblem(F, u, contact, bcs)
     solver = NewtonSolver(comm, problem)
@@ -15,10 +17,15 @@ DOLFINx 0.10 deprecates its ``NewtonSolver`` in favour of SNES, which
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+from dolfinx import fem
 from mpi4py import MPI
 
 from dolfinx_mortar.dolfinx_compat import newton_solver_class
-from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
+
+if TYPE_CHECKING:
+    from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
 
 _Base = newton_solver_class()
 if _Base is None:       # pragma: no cover - a DOLFINx without NewtonSolver
@@ -39,7 +46,7 @@ class NewtonSolver(_Base):
         :meth:`~NonlinearContactProblem.form` are the callbacks.
     """
 
-    def __init__(self, comm: MPI.Intracomm, problem: NonlinearContactProblem):
+    def __init__(self, comm: MPI.Intracomm, problem: "NonlinearContactProblem"):
         super().__init__(comm, problem)
         # not in place of the base class's own matrix: its __del__ destroys that one
         self._problem = problem
@@ -49,3 +56,14 @@ class NewtonSolver(_Base):
     def A(self):
         """The Jacobian matrix (the problem's, with the contact pattern)."""
         return self._problem.matrix()
+
+    def solve(self, u: fem.Function):
+        """Solve from ``u``; returns DOLFINx's ``(iterations, converged)``.
+
+        First the contact terms configure :attr:`krylov_solver` (GLS kinds:
+        their exact augmented step, in place of whatever was set on it):
+        here, so that the user's own settings of the KSP come before.
+        """
+        for term in self._problem.contacts:
+            term.configure_ksp(self.krylov_solver)
+        return super().solve(u)

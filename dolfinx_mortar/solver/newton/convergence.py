@@ -3,7 +3,7 @@
 PETSc's default test accepts a step when ``‖R‖ ≤ rtol ‖R₀‖`` with ``R₀`` the
 residual where Newton starts, or when the Newton step is small
 (``CONVERGED_SNORM_RELATIVE``). Neither means equilibrium here: the
-gap-closing start (:func:`~dolfinx_mortar.solver.newton_start.close_gaps`) can raise ``‖R₀‖`` to
+gap-closing start (:func:`~dolfinx_mortar.solver.newton.start.close_gaps`) can raise ``‖R₀‖`` to
 1e8 times the load, and with a huge penalty the Newton step reaches round-off
 while ``‖R‖`` is still a percent of the load (the force balance was then off
 by 0.4 … 1.8%, silently). :class:`EquilibriumTest` accepts a step only when
@@ -185,6 +185,21 @@ class EquilibriumTest:
 
     def _relative(self, fnorm: float) -> str:
         return f"{fnorm / self.reference:.2e}" if self.reference > 0 else "inf"
+
+
+def carried_force(contacts: Sequence) -> float:
+    """The norm of the contact terms' residual at their last evaluation: the
+    forces the contact carries, the scale of its round-off (``carried`` of
+    :meth:`EquilibriumTest.start`; collective)."""
+    states = [term.state for term in contacts if term.state is not None]
+    if not states:
+        return 0.0
+    total = states[0].residual.copy()
+    for state in states[1:]:
+        total.axpy(1.0, state.residual)
+    norm = total.norm()
+    total.destroy()
+    return norm
 
 
 def describe_failure(snes: PETSc.SNES, test: EquilibriumTest,

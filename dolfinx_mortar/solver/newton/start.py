@@ -3,11 +3,12 @@ gap-closing start for bodies that touch at a point."""
 from __future__ import annotations
 
 from contextlib import ExitStack
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 from petsc4py import PETSc
 
-from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
+if TYPE_CHECKING:
+    from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem
 
 
 class PathExtrapolation:
@@ -30,7 +31,8 @@ class PathExtrapolation:
         return du
 
 
-def close_gaps(problem: NonlinearContactProblem, ksp: PETSc.KSP, x: PETSc.Vec) -> None:
+def close_gaps(problem: "NonlinearContactProblem", ksp: PETSc.KSP, x: PETSc.Vec,
+               A: PETSc.Mat) -> None:
     """Move x into contact when nothing touches yet (a better Newton start).
 
     With positive mortar functions a body that touches at a point has
@@ -40,7 +42,8 @@ def close_gaps(problem: NonlinearContactProblem, ksp: PETSc.KSP, x: PETSc.Vec) -
     nodes near contact carry the force ``ω(d̄ + GΔu)``, which closes their
     gaps: it overshoots by about the largest of those gaps (a tenth of an
     element), which Newton then takes back. It changes only where Newton
-    starts, not the solution.
+    starts, not the solution. ``A`` is the Jacobian matrix of ``ksp``'s
+    solves (with the contact pattern).
     """
     b = problem.vector()
     problem.F(x, b)
@@ -48,7 +51,6 @@ def close_gaps(problem: NonlinearContactProblem, ksp: PETSc.KSP, x: PETSc.Vec) -
         pulls = [stack.enter_context(term.closing_gaps()) for term in problem.contacts]
         if all(p is None for p in pulls):
             return
-        A = problem.matrix()
         problem.J(x, A, ksp)
     rhs = b.copy()
     for pull in pulls:
