@@ -12,44 +12,20 @@ carries the uniform pressure q, to round-off (a patch test). Run:
 import argparse
 import json
 
-import gmsh
 import numpy as np
 import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidPlane
-from dolfinx_mortar.io.gmsh_io import model_to_mesh
+from demo_support.stack import stacked_blocks
 
-# blocks (y0, y1, mesh size), bottom to top; facet tags of their faces
-BLOCKS = [(0.0, 0.25, 0.05), (0.25, 0.5, 0.04), (0.5, 0.75, 0.03)]
+# blocks (x0, x1, y0, y1, mesh size), bottom to top; facet tags of their faces
+BLOCKS = [(0.0, 1.0, 0.0, 0.25, 0.05), (0.0, 1.0, 0.25, 0.5, 0.04), (0.0, 1.0, 0.5, 0.75, 0.03)]
 BOTTOM = (1, 2, 3)           # each block's bottom face
 TOP = (4, 5, 6)              # each block's top face (the last one is loaded)
 LEFT = 7                     # the left edges: u_x = 0
 q = 0.01                     # the traction on the top block's top face
-
-
-def stack(comm: MPI.Comm):
-    gmsh.initialize(["", "-v", "0"])
-    if comm.rank == 0:
-        groups = {tag: [] for tag in (*BOTTOM, *TOP, LEFT)}
-        for k, (y0, y1, h) in enumerate(BLOCKS):
-            block = gmsh.model.occ.addRectangle(0.0, y0, 0, 1.0, y1 - y0)
-            gmsh.model.occ.synchronize()
-            for _, line in gmsh.model.getBoundary([(2, block)], oriented=False):
-                x, y, _ = gmsh.model.occ.getCenterOfMass(1, line)
-                for tag, on in ((BOTTOM[k], np.isclose(y, y0)), (TOP[k], np.isclose(y, y1)),
-                                (LEFT, np.isclose(x, 0.0))):
-                    if on:
-                        groups[tag].append(line)
-            gmsh.model.addPhysicalGroup(2, [block], 10 + k)
-            gmsh.model.mesh.setSize(gmsh.model.getBoundary([(2, block)], recursive=True), h)
-        for tag, lines in groups.items():
-            gmsh.model.addPhysicalGroup(1, lines, tag)
-        gmsh.model.mesh.generate(2)
-    mesh, _, facet_tags = model_to_mesh(gmsh.model, comm, 0)
-    gmsh.finalize()
-    return mesh, facet_tags
 
 
 def main(argv=None) -> dict:
@@ -57,7 +33,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--json", help="write the figures to this file")
     args = parser.parse_args(argv)
     comm = MPI.COMM_WORLD
-    mesh, facet_tags = stack(comm)
+    mesh, facet_tags = stacked_blocks(comm, BLOCKS, BOTTOM, TOP, LEFT)
     V = fem.functionspace(mesh, ("Lagrange", 1, (2,)))
     u, v = fem.Function(V, name="u"), ufl.TestFunction(V)
     E, nu = 1.0, 0.3
