@@ -119,6 +119,8 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     surface = LagrangeSurface(facet_cell, degree, x, cells, layout=layout,
                               quadratic_transform=quadratic_transform,
                               axisymmetric=axisymmetric)
+    # each facet's volume cell: a self-contact surface never pairs facets whose cells touch
+    surface.volume_nodes = cell_dofs[cell_of_facet].astype(np.int64)
     if len(cells) == 0:
         return surface
     # Outward: the facet normal must point away from its cell's centroid.

@@ -123,7 +123,9 @@ class RangeChecks:
             raise ValueError(f"the surface overlaps itself at the start: the node {x} lies "
                              f"{gap:.3g} ({ratio:.3g} element lengths) inside the body's own "
                              "surface. A self-contact surface must start without overlaps: "
-                             "check the geometry and the tag")
+                             "check the geometry and the tag; or a wall of the body thinner "
+                             "than the search radius pairs with its own other side through "
+                             "the material: pass a search_radius below the wall's thickness")
         if ratio > DEEP_PENETRATION:
             hint = ""
             options = self.term.options
