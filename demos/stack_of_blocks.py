@@ -10,14 +10,12 @@ next to ``results/stack_of_blocks.xdmf`` (u and the pressure of all terms).
 Every interface carries the whole load. Run: ``python3 demos/stack_of_blocks.py``
 (or with ``mpirun -n 2``).
 """
-import gmsh
-import numpy as np
 import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidPlane
-from dolfinx_mortar.io.gmsh_io import model_to_mesh
+from demo_support.stack import stacked_blocks
 
 # blocks (x0, x1, y0, y1, mesh size), bottom to top; facet tags of their faces
 BLOCKS = [(0.0, 1.0, 0.0, 0.25, 0.05), (0.0, 0.8, 0.25, 0.5, 0.04), (0.0, 0.6, 0.5, 0.75, 0.03)]
@@ -27,25 +25,7 @@ LEFT = 7                     # the left edges: u_x = 0
 q = 0.01                     # traction on the top block's top face
 
 comm = MPI.COMM_WORLD
-gmsh.initialize(["", "-v", "0"])
-if comm.rank == 0:
-    groups = {tag: [] for tag in (*BOTTOM, *TOP, LEFT)}
-    for k, (x0, x1, y0, y1, h) in enumerate(BLOCKS):
-        block = gmsh.model.occ.addRectangle(x0, y0, 0, x1 - x0, y1 - y0)
-        gmsh.model.occ.synchronize()
-        for _, line in gmsh.model.getBoundary([(2, block)], oriented=False):
-            x, y, _ = gmsh.model.occ.getCenterOfMass(1, line)
-            for tag, on in ((BOTTOM[k], np.isclose(y, y0)), (TOP[k], np.isclose(y, y1)),
-                            (LEFT, np.isclose(x, x0))):
-                if on:
-                    groups[tag].append(line)
-        gmsh.model.addPhysicalGroup(2, [block], 10 + k)
-        gmsh.model.mesh.setSize(gmsh.model.getBoundary([(2, block)], recursive=True), h)
-    for tag, lines in groups.items():
-        gmsh.model.addPhysicalGroup(1, lines, tag)
-    gmsh.model.mesh.generate(2)
-mesh, _, facet_tags = model_to_mesh(gmsh.model, comm, 0)   # the model's dimension: 2
-gmsh.finalize()
+mesh, facet_tags = stacked_blocks(comm, BLOCKS, BOTTOM, TOP, LEFT)
 
 V = fem.functionspace(mesh, ("Lagrange", 1, (2,)))
 u, v = fem.Function(V, name="u"), ufl.TestFunction(V)

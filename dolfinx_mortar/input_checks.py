@@ -291,20 +291,24 @@ def check_tags(mesh, facet_tags, tags: Iterable) -> None:
                                  f"{sorted(present)})")
 
 
-def check_contact_tags(mesh, facet_tags, slave_tag: int, master_tag: Optional[int]) -> None:
-    """Slave and master tags as :func:`check_tags`, and no facet carrying both."""
-    check_tags(mesh, facet_tags, [slave_tag, master_tag])
+def check_contact_tags(mesh, facet_tags, slave_tag, master_tag: Optional[int]) -> None:
+    """Slave tag (or tags) and master tag as :func:`check_tags`, and no facet carrying both."""
+    slave_tags = [slave_tag] if np.ndim(slave_tag) == 0 else list(slave_tag)
+    if not slave_tags:
+        raise ValueError("no slave tag: give one facet tag or a list of them")
+    check_tags(mesh, facet_tags, [*slave_tags, master_tag])
     if master_tag is not None:
-        a, b = facet_tags.find(slave_tag), facet_tags.find(master_tag)
+        a = np.concatenate([facet_tags.find(t) for t in slave_tags])
+        b = facet_tags.find(master_tag)
         if mesh.comm.allreduce(len(np.intersect1d(a, b))) > 0:
             raise ValueError(f"slave tag {slave_tag} and master tag {master_tag} "
                              "overlap: a facet cannot be both")
 
 
 def check_contact_arguments(u, master_tag: Optional[int], obstacle,
-                            axisymmetric: bool) -> None:
-    """The displacement, the master or obstacle and the mesh's dimension given to
-    a contact term."""
+                            axisymmetric: bool, self_contact: bool = False) -> None:
+    """The displacement, the master or obstacle (or self-contact) and the mesh's
+    dimension given to a contact term."""
     if not isinstance(u, dolfinx.fem.Function):
         raise TypeError(f"u must be a dolfinx.fem.Function (the displacement), got "
                         f"{type(u).__name__}")
@@ -316,9 +320,12 @@ def check_contact_arguments(u, master_tag: Optional[int], obstacle,
                          f"dimension {V.mesh.topology.dim} in {gdim}D")
     if V.dofmap.index_map_bs != gdim:
         raise ValueError(f"u must be a vector Function with {gdim} components per node")
-    if (master_tag is None) == (obstacle is None):
+    if self_contact and (master_tag is not None or obstacle is not None):
+        raise ValueError("self_contact=True takes no master_tag and no obstacle: the slave "
+                         "surface is its own master")
+    if not self_contact and (master_tag is None) == (obstacle is None):
         raise ValueError("give exactly one of master_tag (elastic master) and obstacle "
-                         "(rigid analytic obstacle)")
+                         "(rigid analytic obstacle), or self_contact=True")
     if obstacle is not None and not all(hasattr(obstacle, name) for name in
                                         ("gdim", "signed_distance", "gradient", "hessian")):
         raise TypeError(f"the obstacle must be a rigid obstacle (RigidPlane, RigidSphere, "

@@ -30,8 +30,9 @@ LOWER_OFFSET = 10
 GRADING = 1.5
 
 
-def body(comm: MPI.Comm, n: int, dim: int, mirrored: bool = False):
-    """The upper body (or its mirror image) on n cells per direction: mesh and facet tags."""
+def body(comm: MPI.Comm, n: int, dim: int, mirrored: bool = False, lift: float = 0.0):
+    """The upper body (or its mirror image) on n cells per direction, lifted by ``lift``
+    away from z = 0: mesh and facet tags."""
     if dim == 2:
         domain = mesh.create_rectangle(comm, [[0.0, 0.0], [1.0, 1.0]], [n, n],
                                        cell_type=mesh.CellType.quadrilateral)
@@ -41,14 +42,14 @@ def body(comm: MPI.Comm, n: int, dim: int, mirrored: bool = False):
     x = domain.geometry.x
     plane = W * x[:, : dim - 1] ** GRADING
     bottom = R - np.sqrt(R**2 - np.sum(plane**2, axis=1))
-    height = bottom + (H - bottom) * x[:, dim - 1] ** GRADING
+    height = lift + bottom + (H - bottom) * x[:, dim - 1] ** GRADING
     x[:, : dim - 1] = plane
     x[:, dim - 1] = -height if mirrored else height
-    top = -H if mirrored else H
+    top = -(H + lift) if mirrored else H + lift
 
     def on_sphere(p):
         radial = np.sum(p[: dim - 1] ** 2, axis=0)
-        return np.isclose(np.abs(p[dim - 1]), R - np.sqrt(np.maximum(R**2 - radial, 0.0)))
+        return np.isclose(np.abs(p[dim - 1]), lift + R - np.sqrt(np.maximum(R**2 - radial, 0.0)))
 
     marks = [(TOP, lambda p: np.isclose(p[dim - 1], top)), (CONTACT, on_sphere),
              (SYMMETRY_X, lambda p: np.isclose(p[0], 0.0))]
@@ -91,11 +92,15 @@ class MirrorResult:
 
 
 def mirror(n: int, d: float, *, dim: int = 2, axisymmetric: bool = False, penalty: float,
-           load_steps: int = 4, comm: MPI.Comm = MPI.COMM_WORLD, **options) -> MirrorResult:
+           load_steps: int = 4, comm: MPI.Comm = MPI.COMM_WORLD, gap: float = 0.0,
+           **options) -> MirrorResult:
     """Solve both problems; ``options`` go to :class:`ContactProblem` (E and nu default to
-    1 and 0.3). ``penalty`` is the rigid-plane problem's; the pair gets half of it."""
+    1 and 0.3). ``penalty`` is the rigid-plane problem's; the pair gets half of it.
+    ``gap``: the bodies start this far apart (each lifted by half of it off z = 0), and
+    each is moved by ``d`` more than half of it."""
     options = {"E": 1.0, "nu": 0.3, **options}
-    upper, upper_tags = body(comm, n, dim)
+    lift, d = gap / 2, d + gap / 2
+    upper, upper_tags = body(comm, n, dim, lift=lift)
     V = fem.functionspace(upper, ("Lagrange", 1, (dim,)))
     normal = np.zeros(dim)
     normal[-1] = 1.0
@@ -103,8 +108,8 @@ def mirror(n: int, d: float, *, dim: int = 2, axisymmetric: bool = False, penalt
                            fixed=_supports(dim, d), penalty=penalty, axisymmetric=axisymmetric,
                            **options)
     alone.solve(load_steps=load_steps)
-    upper, upper_tags = body(comm, n, dim)
-    lower, lower_tags = body(comm, n, dim, mirrored=True)
+    upper, upper_tags = body(comm, n, dim, lift=lift)
+    lower, lower_tags = body(comm, n, dim, mirrored=True, lift=lift)
     shared = [SYMMETRY_X, SYMMETRY_Y] if dim == 3 else [SYMMETRY_X]
     pair = ContactProblem.from_two_meshes(
         upper, upper_tags, CONTACT, lower, lower_tags, CONTACT, tag_offset=LOWER_OFFSET,

@@ -8,7 +8,7 @@ from typing import Optional
 import numpy as np
 
 from dolfinx_mortar.contact.laws import PenaltyLaw
-from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, parse_kind
+from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, is_global, parse_kind
 
 CONFIGURATIONS = ("initial", "previous", "current")
 
@@ -35,6 +35,8 @@ class ContactOptions:
         the default of the configuration).
     axisymmetric
         The mesh is the (r, z) meridian of a body of revolution.
+    self_contact
+        The slave surface is its own master (two-pass, docs/SELF_CONTACT.md).
     """
 
     kind: BasisKind
@@ -43,6 +45,7 @@ class ContactOptions:
     boundary_modification: bool = False
     search_radius: Optional[float] = None
     axisymmetric: bool = False
+    self_contact: bool = False
 
     @property
     def penalty(self) -> float:
@@ -53,10 +56,12 @@ class ContactOptions:
     def checked(cls, kind: KindLike, penalty: float, scaling: str, active_set: str,
                 basis_configuration: str, boundary_modification: Optional[bool],
                 search_radius: Optional[float], elastic_master: bool,
-                axisymmetric: bool = False) -> "ContactOptions":
+                axisymmetric: bool = False, self_contact: bool = False) -> "ContactOptions":
         """The options from a term's arguments; names the first that is wrong."""
         law = PenaltyLaw.of(kind, penalty, scaling, active_set)
         kind = parse_kind(kind)
+        if self_contact:
+            check_self_contact(kind, basis_configuration, law.pointwise)
         if basis_configuration not in CONFIGURATIONS:
             raise ValueError(f"unknown basis configuration '{basis_configuration}'; "
                              f"expected {CONFIGURATIONS}")
@@ -82,4 +87,21 @@ class ContactOptions:
                           "curved contact tested (Hertz 2D); prefer active_set='nodal'",
                           RuntimeWarning, stacklevel=4)
         return cls(kind, law, basis_configuration, bool(boundary_modification),
-                   None if search_radius is None else float(search_radius), bool(axisymmetric))
+                   None if search_radius is None else float(search_radius), bool(axisymmetric),
+                   bool(self_contact))
+
+
+def check_self_contact(kind: BasisKind, basis_configuration: str, pointwise: bool) -> None:
+    """NotImplementedError naming a combination self-contact does not support, and why."""
+    if pointwise and kind in DUAL_KINDS:
+        raise NotImplementedError(
+            "self_contact=True with the pointwise active set and a dual kind: where the two "
+            "passes meet at the contact edge the negative dual functions make the pressure "
+            "1.6% off its mirror problem (tests/contact/test_self_contact.py); use "
+            "active_set='nodal' or kind='LmLS*'")
+    if is_global(kind):
+        raise NotImplementedError(
+            "self_contact=True with a GLS kind: its L couples every facet of the surface, "
+            "and a surface that pairs with itself has not been verified with it; use a local "
+            "kind (LcLS*, LcLS, LmLS*, LmLS)")
+

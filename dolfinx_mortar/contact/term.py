@@ -20,7 +20,7 @@ from __future__ import annotations
 import time
 from contextlib import contextmanager
 from dataclasses import replace
-from typing import ContextManager, Iterator, Optional, Sequence
+from typing import ContextManager, Iterator, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -56,12 +56,10 @@ class ContactTerm:
     u
         The displacement, a vector Lagrange Function of degree 1 or 2 (the
         unknown of the user's model).
-    facet_tags
-        Facet meshtags of u's mesh.
-    slave_tag
-        Tag of the slave facets.
+    facet_tags, slave_tag
+        Facet meshtags of u's mesh; the slave facets' tag, or a list of tags.
     master_tag
-        Tag of the master facets in the same mesh (two bodies), or None.
+        Tag of the master facets in the same mesh, or None.
     obstacle
         A rigid obstacle (:mod:`dolfinx_mortar.contact.obstacles`) instead of a
         master surface; it may be moved between load steps (``obstacle.move_to``).
@@ -72,24 +70,22 @@ class ContactTerm:
     scaling
         ``"consistent"`` (default) or ``"seed"`` (docs/DESIGN.md, §Scalings).
     active_set
-        ``"nodal"`` (default, penalty on ⟨d̄_A⟩) or ``"pointwise"``
-        (``p_A = ε∫M̄_A⟨d⟩``, unsymmetric exact Jacobian).
+        ``"nodal"`` (default, ε on ⟨d̄_A⟩) or ``"pointwise"`` (``p_A = ε∫M̄_A⟨d⟩``).
     basis_configuration
         ``"initial"`` (default): bases and segmentation in the reference
         configuration, good up to about one element of slip; ``"previous"``:
         rebuilt when a load step starts (:meth:`begin_step`); ``"current"``: on
         the current surfaces, exactly linearized (local kinds).
     quadratic_transform
-        Transformed basis on quadratic triangle facets (always on axisymmetric
-        P2 lines, see ``axisymmetric``).
+        Transformed basis on quadratic triangle facets (always on axisymmetric P2 lines).
     boundary_modification
         Elastic master, dual kinds: the basis rebuilt over the covered part of
         partly covered slave facets (Popp et al. 2013; docs/DESIGN.md, §Boundary
         modification). ``None`` (default): on where it is implemented (dual
         kinds, elastic master, nodal set, "initial" and "previous").
     search_radius
-        How far along its normal a slave facet reaches for master facets to
-        pair with (default the largest slave facet diameter).
+        How far along its normal a slave facet reaches for master facets
+        (default the largest slave facet diameter; widened where contact needs it).
     axisymmetric
         The mesh is the (r, z) half-plane of a body of revolution: every contact
         integral carries 2πr, forces are the whole body's (docs/AXISYMMETRIC.md;
@@ -98,33 +94,38 @@ class ContactTerm:
         A friction law (:class:`~dolfinx_mortar.contact.laws.CoulombFriction`, or
         any :class:`~dolfinx_mortar.contact.laws.TangentialLaw`); None:
         frictionless (default). Its history moves on in :meth:`accept_step`.
+    self_contact
+        The slave surface is its own master: a body that may touch itself, or
+        several bodies under one term (docs/SELF_CONTACT.md).
     name
         Names the term's output file ``<output>_<name>.xdmf`` (letters, digits,
         ``_``, ``-``); None: from the slave tag (:mod:`dolfinx_mortar.io.contact_output`).
     """
 
-    def __init__(self, u: fem.Function, facet_tags, slave_tag: int, *,
+    def __init__(self, u: fem.Function, facet_tags, slave_tag: Union[int, Sequence[int]], *,
                  master_tag: Optional[int] = None, obstacle: Optional[RigidObstacle] = None,
                  kind: KindLike = "LcLS*", penalty: float, scaling: str = "consistent",
                  active_set: str = "nodal", basis_configuration: str = "initial",
                  quadratic_transform: bool = False,
                  boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, axisymmetric: bool = False,
-                 friction: Optional[TangentialLaw] = None, name: Optional[str] = None):
+                 friction: Optional[TangentialLaw] = None, name: Optional[str] = None,
+                 self_contact: bool = False):
         # one decision of all ranks: an argument bad on one rank only raises on every rank
         with collective_checks(communicator_of(u)):
-            check_contact_arguments(u, master_tag, obstacle, axisymmetric)
-            check_tangential_law(friction)
+            check_contact_arguments(u, master_tag, obstacle, axisymmetric, self_contact)
+            check_tangential_law(friction, self_contact)
             #: the name of the term's output (None: from the slave tag)
             self.name: Optional[str] = check_term_name(name)
             options = ContactOptions.checked(
                 kind, penalty, scaling, active_set, basis_configuration,
-                boundary_modification, search_radius, master_tag is not None, axisymmetric)
+                boundary_modification, search_radius, master_tag is not None or self_contact,
+                axisymmetric, self_contact)
         V = u.function_space
         check_cells(V.mesh)
         check_contact_tags(V.mesh, facet_tags, slave_tag, master_tag)
-        #: the slave facets' tag
-        self.slave_tag = int(slave_tag)
+        #: the slave facets' tag (or tags)
+        self.slave_tag = int(slave_tag) if np.ndim(slave_tag) == 0 else tuple(map(int, slave_tag))
         #: the displacement
         self.u = u
         self._V = V
@@ -132,9 +133,9 @@ class ContactTerm:
         self.obstacle = obstacle
         #: the slave surface (its nodes, cells and their layout over the ranks)
         self.slave = facet_surface(V, facet_tags, slave_tag, quadratic_transform, axisymmetric)
-        #: the master surface (None against an obstacle)
-        self.master = (facet_surface(V, facet_tags, master_tag, axisymmetric=axisymmetric)
-                       if master_tag is not None else None)
+        #: the master surface (None against an obstacle; the slave's own in self-contact)
+        self.master = (self.slave if self_contact else None if master_tag is None
+                       else facet_surface(V, facet_tags, master_tag, axisymmetric=axisymmetric))
         check_penalty_represents_a_force(options.penalty, self.slave, self.comm)
         #: the checked options (kind, penalty law, configuration, …)
         self.options = options

@@ -56,7 +56,8 @@ def output_names(contacts: Sequence) -> list[str]:
         If two terms would write the same file.
     """
     names = [term.name if term.name is not None
-             else "slave" if len(contacts) == 1 else f"slave{term.slave_tag}"
+             else "slave" if len(contacts) == 1
+             else "slave" + "-".join(map(str, np.atleast_1d(term.slave_tag)))
              for term in contacts]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:

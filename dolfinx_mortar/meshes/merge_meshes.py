@@ -88,123 +88,158 @@ def _global_values(comm: MPI.Comm, values: npt.ArrayLike) -> set:
 
 def merge_meshes(mesh_a, facet_tags_a, mesh_b, facet_tags_b, comm: Optional[MPI.Comm] = None,
                  *, tag_offset: int = 0, shared_tags: Sequence[int] = ()):
-    """One mesh holding the bodies of ``mesh_a`` and ``mesh_b``, disconnected.
-
-    Parameters
-    ----------
-    mesh_a, mesh_b
-        DOLFINx meshes with the same cell type, geometric dimension and
-        geometry degree, distributed over the same ranks (any distribution).
-    facet_tags_a, facet_tags_b
-        Their facet meshtags (int32).
-    comm
-        Communicator of the merged mesh; default ``mesh_a.comm``. Must hold the
-        same ranks in the same order as the meshes' communicators.
-    tag_offset
-        Added to every facet tag value of b except ``shared_tags``.
-    shared_tags
-        Values that may mark facets of both bodies; kept as they are in b.
+    """One mesh holding the bodies of ``mesh_a`` and ``mesh_b``, disconnected:
+    :func:`merge_bodies` of the two, b's tag values shifted by ``tag_offset``.
 
     Returns
     -------
     mesh, facet_tags, cell_tags
-        The merged mesh; its facet tags (a's values, b's values shifted as
-        described above); cell tags :data:`BODY_A` = 1 on a's cells and
+        The merged mesh; its facet tags (a's values, b's values shifted except
+        ``shared_tags``); cell tags :data:`BODY_A` = 1 on a's cells and
         :data:`BODY_B` = 2 on b's cells.
+    """
+    return merge_bodies([mesh_a, mesh_b], [facet_tags_a, facet_tags_b], comm,
+                        tag_offsets=[0, tag_offset], shared_tags=shared_tags)
+
+
+def merge_bodies(meshes: Sequence, facet_tags: Sequence, comm: Optional[MPI.Comm] = None,
+                 *, tag_offsets: Optional[Sequence[int]] = None,
+                 shared_tags: Sequence[int] = ()):
+    """One mesh holding the bodies of all ``meshes``, disconnected, in one call.
+
+    Parameters
+    ----------
+    meshes
+        DOLFINx meshes with the same cell type, geometric dimension and
+        geometry degree, distributed over the same ranks (any distribution).
+    facet_tags
+        Their facet meshtags (int32), one per mesh.
+    comm
+        Communicator of the merged mesh; default the first mesh's. Must hold the
+        same ranks in the same order as the meshes' communicators.
+    tag_offsets
+        Added to every facet tag value of each mesh except ``shared_tags``
+        (default: none).
+    shared_tags
+        Values that may mark facets of several bodies; kept as they are.
+
+    Returns
+    -------
+    mesh, facet_tags, cell_tags
+        The merged mesh; its facet tags; cell tags k + 1 on the cells of ``meshes[k]``.
 
     Raises
     ------
     ValueError
         If the meshes differ in cell type, geometric dimension or geometry
         degree, the communicators differ, a tag object is not a facet tag of
-        its mesh, or a tag value (after the offset) marks facets of both
+        its mesh, or a tag value (after the offsets) marks facets of two
         bodies without being in ``shared_tags``.
     """
     import ufl
     from dolfinx.io import distribute_entity_data
     from dolfinx.mesh import meshtags_from_entities
 
-    comm = mesh_a.comm if comm is None else comm
-    for name, domain in (("mesh_a", mesh_a), ("mesh_b", mesh_b)):
+    meshes, facet_tags = list(meshes), list(facet_tags)
+    if len(meshes) < 1 or len(meshes) != len(facet_tags):
+        raise ValueError(f"need one facet tag object per mesh, got {len(meshes)} meshes and "
+                         f"{len(facet_tags)} tag objects")
+    offsets_in = [0] * len(meshes) if tag_offsets is None else [int(t) for t in tag_offsets]
+    if len(offsets_in) != len(meshes):
+        raise ValueError(f"need one tag offset per mesh, got {len(offsets_in)}")
+    first = meshes[0]
+    comm = first.comm if comm is None else comm
+    names = ["mesh_a", "mesh_b"] if len(meshes) == 2 else [f"meshes[{k}]" for k in range(len(meshes))]
+    tag_names = (["facet_tags_a", "facet_tags_b"] if len(meshes) == 2
+                 else [f"facet_tags[{k}]" for k in range(len(meshes))])
+    for name, domain in zip(names, meshes):
         if MPI.Comm.Compare(comm, domain.comm) not in (MPI.IDENT, MPI.CONGRUENT):
             raise ValueError(f"{name} lives on another communicator than the merged mesh")
-    cell_a, cell_b = mesh_a.topology.cell_type, mesh_b.topology.cell_type
-    if cell_a != cell_b:
-        raise ValueError(f"cannot merge a {cell_a.name} mesh with a {cell_b.name} mesh: "
-                         "both meshes need the same cell type")
-    deg_a, deg_b = (dolfinx_compat.coordinate_element(m).degree for m in (mesh_a, mesh_b))
-    if deg_a != deg_b:
-        raise ValueError(f"cannot merge geometry degree {deg_a} with geometry degree {deg_b}: "
-                         "both meshes need the same coordinate element")
-    gdim = mesh_a.geometry.dim
-    if mesh_b.geometry.dim != gdim:
-        raise ValueError(f"cannot merge a {gdim}D mesh with a {mesh_b.geometry.dim}D mesh")
-    tdim = mesh_a.topology.dim
-    for name, tags, domain in (("facet_tags_a", facet_tags_a, mesh_a),
-                               ("facet_tags_b", facet_tags_b, mesh_b)):
+    cell_a, degree, gdim = (first.topology.cell_type,
+                            dolfinx_compat.coordinate_element(first).degree, first.geometry.dim)
+    for domain in meshes[1:]:
+        if domain.topology.cell_type != cell_a:
+            raise ValueError(f"cannot merge a {cell_a.name} mesh with a "
+                             f"{domain.topology.cell_type.name} mesh: both meshes need the "
+                             "same cell type")
+        if dolfinx_compat.coordinate_element(domain).degree != degree:
+            raise ValueError(f"cannot merge geometry degree {degree} with geometry degree "
+                             f"{dolfinx_compat.coordinate_element(domain).degree}: both meshes "
+                             "need the same coordinate element")
+        if domain.geometry.dim != gdim:
+            raise ValueError(f"cannot merge a {gdim}D mesh with a {domain.geometry.dim}D mesh")
+    tdim = first.topology.dim
+    for name, tags, domain in zip(tag_names, facet_tags, meshes):
         if tags.dim != tdim - 1 or not dolfinx_compat.tags_belong_to(tags, domain):
             raise ValueError(f"{name} must be facet tags (dim {tdim - 1}) of its own mesh, "
                              f"got dim {tags.dim}")
 
-    # b's tag values, and the clash check on the values present on any rank
+    # each body's tag values, and the clash check on the values present on any rank
     shared = {int(t) for t in shared_tags}
-    values_b = np.asarray(facet_tags_b.values, dtype=np.int64)
-    values_b = np.where(np.isin(values_b, list(shared)), values_b, values_b + int(tag_offset))
-    if values_b.size and (values_b.max() > np.iinfo(np.int32).max
-                          or values_b.min() < np.iinfo(np.int32).min):
-        raise ValueError(f"tag_offset {tag_offset} pushes tag values beyond int32")
-    clash = sorted((_global_values(comm, facet_tags_a.values)
-                    & _global_values(comm, values_b)) - shared)
-    if clash:
-        # name b's values as the user wrote them, not only as shifted
-        written = (f" (mesh_b's {[v - int(tag_offset) for v in clash]} shifted by tag_offset "
-                   f"{tag_offset})" if tag_offset else "")
-        raise ValueError(f"facet tag values {clash} mark facets of both meshes{written}; pass "
-                         "tag_offset= to shift mesh_b's values, or list the values in "
-                         "shared_tags= if they are meant to mark both bodies")
+    values = []
+    for tags, offset in zip(facet_tags, offsets_in):
+        v = np.asarray(tags.values, dtype=np.int64)
+        v = np.where(np.isin(v, list(shared)), v, v + offset)
+        if v.size and (v.max() > np.iinfo(np.int32).max or v.min() < np.iinfo(np.int32).min):
+            raise ValueError(f"tag_offset {offset} pushes tag values beyond int32")
+        values.append(v)
+    present = [_global_values(comm, v) - shared for v in values]
+    for k in range(1, len(values)):
+        for other in range(k):
+            clash = sorted(present[other] & present[k])
+            if clash:
+                # name the later body's values as the user wrote them, not only as shifted
+                offset = offsets_in[k]
+                written = (f" ({names[k]}'s {[v - offset for v in clash]} shifted by "
+                           f"tag_offset {offset})" if offset else "")
+                bodies = "" if len(values) == 2 else f" ({names[other]} and {names[k]})"
+                raise ValueError(f"facet tag values {clash} mark facets of both meshes"
+                                 f"{written}{bodies}; pass tag_offset= to shift the values, "
+                                 "or list the values in shared_tags= if they are meant to "
+                                 "mark both bodies")
 
-    # Merged node numbering: rank r holds the rows [offset_r, offset_r + n_a_r + n_b_r)
-    # (create_mesh numbers the rows of x contiguously by rank): a's owned nodes, then b's.
-    x_a, l2g_a, cells_a = _owned_node_data(mesh_a)
-    x_b, l2g_b, cells_b = _owned_node_data(mesh_b)
-    counts = np.array(comm.allgather((len(x_a), len(x_b))), dtype=np.int64).reshape(-1, 2)
+    # Merged node numbering: rank r holds the rows [offset_r, offset_r + Σ_k n_k,r)
+    # (create_mesh numbers the rows of x contiguously by rank): each body's owned nodes in turn.
+    data = [_owned_node_data(domain) for domain in meshes]
+    counts = np.array(comm.allgather([len(x) for x, _, _ in data]),
+                      dtype=np.int64).reshape(-1, len(meshes))
     offsets = np.concatenate([[0], np.cumsum(counts.sum(axis=1))[:-1]])
-    starts_a = np.array(comm.allgather(mesh_a.geometry.index_map().local_range[0]),
-                        dtype=np.int64)
-    starts_b = np.array(comm.allgather(mesh_b.geometry.index_map().local_range[0]),
-                        dtype=np.int64)
-
-    def renumber(global_nodes, starts, shift):
+    new_numbers = []
+    for k, (domain, (_, l2g, _)) in enumerate(zip(meshes, data)):
+        starts = np.array(comm.allgather(domain.geometry.index_map().local_range[0]),
+                          dtype=np.int64)
+        shift = counts[:, :k].sum(axis=1)
         # owner of each node from the owners' ranges, then its row in the merged x
-        owner = np.searchsorted(starts, global_nodes, side="right") - 1
-        return global_nodes - starts[owner] + offsets[owner] + shift[owner]
-
-    new_a = renumber(l2g_a, starts_a, np.zeros(len(counts), dtype=np.int64))
-    new_b = renumber(l2g_b, starts_b, counts[:, 0])
-    cells = np.vstack([new_a[cells_a], new_b[cells_b]]).astype(np.int64)
-    x = np.vstack([x_a, x_b])
+        owner = np.searchsorted(starts, l2g, side="right") - 1
+        new_numbers.append(l2g - starts[owner] + offsets[owner] + shift[owner])
+    cells = np.vstack([new[cells_k] for new, (_, _, cells_k) in zip(new_numbers, data)]
+                      ).astype(np.int64)
+    x = np.vstack([x_k for x_k, _, _ in data])
     # a new UFL domain: create_mesh ties the one it gets to the new mesh
-    ufl_domain = ufl.Mesh(mesh_a.ufl_domain().ufl_coordinate_element())
+    ufl_domain = ufl.Mesh(first.ufl_domain().ufl_coordinate_element())
     domain = dolfinx_compat.create_mesh(comm, cells, x, ufl_domain)
 
     # cell tags: every owned input cell with its body
-    body = np.concatenate([np.full(len(cells_a), BODY_A, dtype=np.int32),
-                           np.full(len(cells_b), BODY_B, dtype=np.int32)])
-    entities, values = distribute_entity_data(domain, tdim, cells, body)
+    body = np.concatenate([np.full(len(cells_k), k + 1, dtype=np.int32)
+                           for k, (_, _, cells_k) in enumerate(data)])
+    entities, cell_values = distribute_entity_data(domain, tdim, cells, body)
     domain.topology.create_connectivity(tdim, 0)
     cell_tags = meshtags_from_entities(domain, tdim, _adjacency(entities),
-                                       values.astype(np.int32))
+                                       cell_values.astype(np.int32))
     cell_tags.name = "Cell tags"
 
     # facet tags: by their nodes in the merged numbering
-    facets_a, tag_values_a = _owned_tagged_facets(mesh_a, facet_tags_a)
-    facets_b, _ = _owned_tagged_facets(mesh_b, facet_tags_b)
-    owned_b = facet_tags_b.indices < mesh_b.topology.index_map(tdim - 1).size_local
-    facet_nodes = np.vstack([new_a[facets_a], new_b[facets_b]]).astype(np.int64)
-    facet_values = np.concatenate([tag_values_a, values_b[owned_b]]).astype(np.int32)
-    entities, values = distribute_entity_data(domain, tdim - 1, facet_nodes, facet_values)
+    nodes, tag_values = [], []
+    for mesh_k, tags, v, new in zip(meshes, facet_tags, values, new_numbers):
+        facets_k, _ = _owned_tagged_facets(mesh_k, tags)
+        owned = tags.indices < mesh_k.topology.index_map(tdim - 1).size_local
+        nodes.append(new[facets_k])
+        tag_values.append(v[owned])
+    facet_nodes = np.vstack(nodes).astype(np.int64)
+    entities, facet_values = distribute_entity_data(domain, tdim - 1, facet_nodes,
+                                                    np.concatenate(tag_values).astype(np.int32))
     domain.topology.create_connectivity(tdim - 1, tdim)
-    facet_tags = meshtags_from_entities(domain, tdim - 1, _adjacency(entities),
-                                        values.astype(np.int32))
-    facet_tags.name = "Facet tags"
-    return domain, facet_tags, cell_tags
+    merged_tags = meshtags_from_entities(domain, tdim - 1, _adjacency(entities),
+                                         facet_values.astype(np.int32))
+    merged_tags.name = "Facet tags"
+    return domain, merged_tags, cell_tags

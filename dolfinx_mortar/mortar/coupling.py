@@ -31,7 +31,7 @@ from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
-from dolfinx_mortar.mortar.facet_search import candidate_pairs
+from dolfinx_mortar.mortar.facet_search import candidate_pairs, near_in_surface
 # the surfaces' geometry lives in surface_normals; these names stay importable here
 from dolfinx_mortar.mortar.surface_normals import (  # noqa: F401
     SurfaceCopy, averaged_nodal_normals, cluster_diameters, current_coordinates,
@@ -109,6 +109,10 @@ class MortarCoupling:
         master normal instead of the slave normal alone
         (:func:`interface_nodal_normals`): the segmentation runs twice. For a
         configuration frozen before the bodies have flattened against each other.
+    self_contact
+        ``master`` is ``slave`` (a surface that may touch itself): pairs of facets
+        that are neighbours on the surface are never candidates
+        (:func:`~dolfinx_mortar.mortar.facet_search.near_in_surface`).
 
     Raises
     ------
@@ -125,7 +129,7 @@ class MortarCoupling:
                  quadrature_degree: Optional[int] = None,
                  opposing_normals_only: bool = True, keep_points: bool = False,
                  facet_search_factor: Optional[float] = None,
-                 interface_normals: bool = False):
+                 interface_normals: bool = False, self_contact: bool = False):
         if slave.gdim != master.gdim:
             raise ValueError(f"slave ({slave.gdim}D) and master ({master.gdim}D) surfaces "
                              "live in different dimensions")
@@ -155,6 +159,9 @@ class MortarCoupling:
         slave_cells = slave.cells.astype(np.int32)
         self.search_radius, candidates = candidate_pairs(
             slave, xs, slave_cells, clusters, master_copy, search_radius, facet_search_factor)
+        if self_contact:
+            # a surface against itself: a facet's neighbours are never its partners
+            candidates = candidates[~near_in_surface(slave, master_copy, candidates)]
         self.timings["search"] = time.perf_counter() - clock
         clock = time.perf_counter()
         degree = quadrature_degree or (polynomial_degree(slave)

@@ -77,3 +77,41 @@ def candidate_pairs(slave: LagrangeSurface, xs: FloatArray, slave_cells: npt.NDA
     master_boxes = _kernels.facet_bounding_boxes(master_copy.facet_type, master_copy.x,
                                                  master_copy.cells, 0.0)
     return search_radius, _kernels.overlapping_box_pairs(slave_boxes, master_boxes)
+
+
+def near_in_surface(slave: LagrangeSurface, master_copy: SurfaceCopy,
+                    candidates: npt.NDArray, rings: int = 2) -> npt.NDArray[np.bool_]:
+    """Which candidate pairs of a surface with itself (self-contact) are
+    neighbours: the two facets share a node, or (``rings`` = 2) both share one
+    with a third facet, or (where the surface knows its volume cells,
+    ``volume_nodes``) the cells of the volume mesh they bound share a node.
+    Such facets meet at an edge or a corner, where they face each other at zero
+    distance, or bound a wall one or two cells thick, whose other side faces
+    them through the material; they are never in contact with each other. The
+    test is on global node numbers, so it does not depend on where the surface
+    has moved. ``master_copy`` must be the surface itself, gathered.
+    """
+    import scipy.sparse
+    if len(candidates) == 0:
+        return np.zeros(0, dtype=bool)
+    size = slave.layout.size_global
+
+    def incidence(global_nodes: npt.NDArray) -> "scipy.sparse.csr_matrix":
+        rows = np.repeat(np.arange(len(global_nodes)), global_nodes.shape[1])
+        return scipy.sparse.csr_matrix((np.ones(rows.size), (rows, global_nodes.ravel())),
+                                       shape=(len(global_nodes), size))
+
+    S = incidence(slave.layout.global_indices[slave.cells])
+    M = incidence(master_copy.global_ids[master_copy.cells])
+    near = S @ M.T                     # share a node
+    for _ in range(rings - 1):
+        near = near @ (M @ M.T)        # … or share one with a facet that does
+    if slave.volume_nodes is not None:
+        # … or bound cells that share one (the gathered copy is in rank order)
+        volume = slave.layout.global_indices[slave.volume_nodes]
+        comm = slave.layout.comm
+        gathered = np.concatenate(comm.allgather(volume)).reshape(-1, volume.shape[1]) \
+            if comm.size > 1 else volume
+        near = near + incidence(volume) @ incidence(gathered).T
+    values = np.asarray(near[candidates[:, 0], candidates[:, 1]]).ravel()
+    return values > 0

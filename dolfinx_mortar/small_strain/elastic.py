@@ -56,7 +56,8 @@ class ContactProblem:
     V
         Vector Lagrange function space of degree 1 or 2 for the displacement.
     facet_tags, slave_tag, master_tag, obstacle, kind, penalty, scaling, active_set,
-    basis_configuration, quadratic_transform, boundary_modification, search_radius, friction
+    basis_configuration, quadratic_transform, boundary_modification, search_radius, friction,
+    self_contact
         The contact term's (:class:`~dolfinx_mortar.contact.term.ContactTerm`).
     E, nu
         Young's modulus and Poisson's ratio.
@@ -75,7 +76,7 @@ class ContactProblem:
         term is axisymmetric; forces are those on the whole body.
     """
 
-    def __init__(self, V: fem.FunctionSpace, facet_tags, slave_tag: int, *,
+    def __init__(self, V: fem.FunctionSpace, facet_tags, slave_tag, *,
                  master_tag: Optional[int] = None, obstacle: Optional[RigidObstacle] = None,
                  E: float, nu: float, kind: KindLike = "LcLS*", penalty: float,
                  scaling: str = "consistent", active_set: str = "nodal",
@@ -85,7 +86,7 @@ class ContactProblem:
                  boundary_modification: Optional[bool] = None,
                  search_radius: Optional[float] = None, petsc_options: Optional[dict] = None,
                  axisymmetric: bool = False, linear_solver: str = "auto",
-                 friction: Optional[CoulombFriction] = None):
+                 friction: Optional[CoulombFriction] = None, self_contact: bool = False):
         # one decision of all ranks: an argument bad on one rank only raises on every rank
         with collective_checks(communicator_of(V)):
             mesh = V.mesh
@@ -107,7 +108,7 @@ class ContactProblem:
             kind=kind, penalty=penalty, scaling=scaling, active_set=active_set,
             basis_configuration=basis_configuration, quadratic_transform=quadratic_transform,
             boundary_modification=boundary_modification, search_radius=search_radius,
-            axisymmetric=axisymmetric, friction=friction)
+            axisymmetric=axisymmetric, friction=friction, self_contact=self_contact)
         check_penalty_against_stiffness(self.contact.options.penalty, E, self.contact.slave,
                                         mesh.comm)
         #: the load factor, 0 … 1

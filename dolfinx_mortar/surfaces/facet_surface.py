@@ -7,7 +7,7 @@ the displacement's dofs without any renumbering.
 """
 from __future__ import annotations
 
-from typing import Union
+from typing import Sequence, Union
 
 import dolfinx
 import numpy as np
@@ -23,7 +23,7 @@ _FACET_CELL = {"interval": "point", "triangle": "interval",
 
 
 def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
-                  facet_tags: dolfinx.mesh.MeshTags, tag: int,
+                  facet_tags: dolfinx.mesh.MeshTags, tag: Union[int, Sequence[int]],
                   quadratic_transform: bool = False,
                   axisymmetric: bool = False) -> LagrangeSurface:
     """The surface of the facets marked ``tag``, owned by this rank.
@@ -40,7 +40,7 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     facet_tags
         Facet meshtags.
     tag
-        The value marking the slave facets.
+        The value marking the slave facets, or several (their facets together).
     quadratic_transform
         Use the transformed quadratic basis on quadratic triangle facets.
     axisymmetric
@@ -78,7 +78,8 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
                          f"surface needs facet tags (dimension {fdim}) of this "
                          f"{tdim}D mesh")
     comm = mesh.comm
-    facets = facet_tags.find(tag)
+    tags = [tag] if np.ndim(tag) == 0 else list(tag)
+    facets = np.unique(np.concatenate([facet_tags.find(t) for t in tags]))
     facets = facets[facets < mesh.topology.index_map(fdim).size_local]
     if comm.allreduce(len(facets)) == 0:
         present = sorted({int(v) for values in comm.allgather(np.unique(facet_tags.values))
@@ -118,6 +119,8 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
     surface = LagrangeSurface(facet_cell, degree, x, cells, layout=layout,
                               quadratic_transform=quadratic_transform,
                               axisymmetric=axisymmetric)
+    # each facet's volume cell: a self-contact surface never pairs facets whose cells touch
+    surface.volume_nodes = cell_dofs[cell_of_facet].astype(np.int64)
     if len(cells) == 0:
         return surface
     # Outward: the facet normal must point away from its cell's centroid.

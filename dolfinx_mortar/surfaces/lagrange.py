@@ -16,7 +16,7 @@ import numpy.typing as npt
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.layout import NodeLayout
-from dolfinx_mortar.surfaces.tabulation import Tabulation
+from dolfinx_mortar.surfaces.tabulation import Tabulation, measure_from_tangents
 from dolfinx_mortar.tolerance import GEOMETRIC_TOLERANCE, length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
@@ -181,6 +181,10 @@ class LagrangeSurface:
         transformed, it is 2πh²/15 > 0.
     """
 
+    #: the nodes of each facet's cell of the volume mesh (local, as ``cells``), where the
+    #: surface was taken from one (:func:`~dolfinx_mortar.surfaces.facet_surface.facet_surface`)
+    volume_nodes: Optional[npt.NDArray[np.int64]] = None
+
     def __init__(self, cell: str, degree: int, x: npt.ArrayLike, cells: npt.ArrayLike,
                  layout: Optional[NodeLayout] = None, serendipity: bool = False,
                  quadratic_transform: bool = False, check_cells: bool = True,
@@ -300,11 +304,7 @@ class LagrangeSurface:
 
     def moved(self, displacement: FloatArray) -> "LagrangeSurface":
         """The same surface with its nodes displaced (a new configuration)."""
-        return LagrangeSurface(self.reference.cell, self.reference.degree,
-                               self.x + displacement, self.cells, layout=self.layout,
-                               serendipity=self.reference.serendipity,
-                               quadratic_transform=self.reference.transform is not None,
-                               axisymmetric=self.axisymmetric)
+        return self._like(self.x + displacement, self.cells, check_cells=True)
 
     def reflected(self, which: npt.ArrayLike) -> "LagrangeSurface":
         """The same surface with the cells marked in ``which`` reflected (normal flipped)."""
@@ -312,10 +312,15 @@ class LagrangeSurface:
         which = np.asarray(which, dtype=bool)
         cells[which] = cells[which][:, self.reference.reflection]
         # the same facets (checked already); callers reflect on some ranks only
-        return LagrangeSurface(self.reference.cell, self.reference.degree, self.x, cells,
+        return self._like(self.x, cells, check_cells=False)
+
+    def _like(self, x: FloatArray, cells: npt.NDArray, check_cells: bool) -> "LagrangeSurface":
+        like = LagrangeSurface(self.reference.cell, self.reference.degree, x, cells,
                                layout=self.layout, serendipity=self.reference.serendipity,
                                quadratic_transform=self.reference.transform is not None,
-                               check_cells=False, axisymmetric=self.axisymmetric)
+                               check_cells=check_cells, axisymmetric=self.axisymmetric)
+        like.volume_nodes = self.volume_nodes
+        return like
 
     @property
     def num_elements(self) -> int:
@@ -387,14 +392,3 @@ class LagrangeSurface:
         N, _, _ = self.tabulate_at(cells, X)
         return cells, N
 
-
-def measure_from_tangents(tangents: list) -> FloatArray:
-    """|t₀| (lines) or |t₀ × t₁| (surfaces, which live in 3D).
-
-    The cross product, not sqrt(|t₀|²|t₁|² − (t₀·t₁)²): that difference
-    cancels catastrophically on slivers (94% off at aspect 1e8).
-    """
-    if len(tangents) == 1:
-        return np.linalg.norm(tangents[0], axis=-1)
-    t0, t1 = tangents
-    return np.linalg.norm(np.cross(t0, t1), axis=-1)

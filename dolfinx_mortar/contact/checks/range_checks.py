@@ -16,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
+from dolfinx_mortar.contact.checks.missed_contact import MissedContact
 from dolfinx_mortar.contact.checks.setup_checks import (check_initial_overlap,
                                                         warn_if_the_obstacle_faces_away)
 from dolfinx_mortar.contact.checks.thresholds import (BODY_PENETRATION, DEEP_PENETRATION,
@@ -89,6 +90,8 @@ class RangeChecks:
         self._body_warned = False
         #: (coupling, slave nodes a four times wider search pairs) of the last check
         self._beyond_radius: Optional[tuple] = None
+        #: the check for contact that the pairs missed
+        self.missed = MissedContact(term, configuration)
         #: times the default search radius was widened, and whether reaching it was warned
         self._radius_widenings = 0
         self._radius_warned = False
@@ -116,6 +119,13 @@ class RangeChecks:
         on_local_cell[slave.cells] = True
         covered = state.covered & on_local_cell
         ratio, gap, x = self.term.results.deepest(np.where(covered, state.gaps, -np.inf))
+        if ratio > DEEP_PENETRATION and self.term.options.self_contact:
+            raise ValueError(f"the surface overlaps itself at the start: the node {x} lies "
+                             f"{gap:.3g} ({ratio:.3g} element lengths) inside the body's own "
+                             "surface. A self-contact surface must start without overlaps: "
+                             "check the geometry and the tag; or a wall of the body thinner "
+                             "than the search radius pairs with its own other side through "
+                             "the material: pass a search_radius below the wall's thickness")
         if ratio > DEEP_PENETRATION:
             hint = ""
             options = self.term.options
@@ -284,6 +294,16 @@ class RangeChecks:
         return bool(comm.allreduce(bool(np.any(reached & near_edge)), op=MPI.LOR))
 
     def wider_search_radius(self, state: Optional[ContactState] = None) -> Optional[float]:
+        """After a converged step: the search radius the term's bases need, None
+        where the present one serves: where the contact zone reached the radius
+        (:meth:`radius_reached`) or where slave nodes passed through the master
+        outside the pairs (:class:`~dolfinx_mortar.contact.checks.missed_contact.MissedContact`;
+        collective)."""
+        state = state or self.term.evaluate()
+        radius = self.radius_reached(state)
+        return radius if radius is not None else self.missed.wider_radius(state)
+
+    def radius_reached(self, state: Optional[ContactState] = None) -> Optional[float]:
         """After a converged step: where the contact zone reached slave nodes
         that found no master within the search radius though one lies beyond it
         (:meth:`contact_reached_the_search_radius`), four times the radius, for

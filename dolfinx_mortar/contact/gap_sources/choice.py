@@ -17,6 +17,7 @@ from mpi4py import MPI
 from dolfinx_mortar.contact.gap_sources.current import CurrentMortarGap
 from dolfinx_mortar.contact.gap_sources.current import CurrentObstacleGap
 from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
+from dolfinx_mortar.contact.gap_sources.self_contact import CurrentSelfContactGap, SelfContactGap
 from dolfinx_mortar.contact.gap_sources.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
@@ -35,6 +36,8 @@ def current_model(options: ContactOptions, slave: LagrangeSurface,
     measures each step's slip on the frozen model where the step starts."""
     if obstacle is not None:
         model = CurrentObstacleGap(slave, obstacle, options.kind, options.law)
+    elif options.self_contact:
+        model = CurrentSelfContactGap(slave, options.kind, options.law, options.search_radius)
     else:
         model = CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius)
     model.frozen_at = partial(frozen_model, options, slave, master, obstacle)
@@ -58,9 +61,10 @@ def frozen_model(options: ContactOptions, slave: LagrangeSurface,
             slave, master = slave.moved(u_nodes), master.moved(u_nodes)
         coupling = MortarCoupling(slave, master, keep_points=law.pointwise,
                                   search_radius=options.search_radius,
-                                  interface_normals=True)
-        model = MortarGap(coupling, law, None if u_nodes is None else u_vector,
-                          boundary_modification=options.boundary_modification)
+                                  interface_normals=True, self_contact=options.self_contact)
+        source = SelfContactGap if options.self_contact else MortarGap
+        model = source(coupling, law, None if u_nodes is None else u_vector,
+                       boundary_modification=options.boundary_modification)
         mass = covered_mass(coupling) if is_global(options.kind) else None
     if is_global(options.kind):
         return GlobalGap(model, law, mass)

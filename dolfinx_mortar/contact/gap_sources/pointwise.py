@@ -25,7 +25,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.gap_sources.cut_quadrature import positive_part_rule
 from dolfinx_mortar.contact.obstacles import relative_to
 from dolfinx_mortar.contact.laws import positive_part
-from dolfinx_mortar.surfaces.lagrange import measure_from_tangents
+from dolfinx_mortar.surfaces.tabulation import measure_from_tangents
 from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 
 FloatArray = npt.NDArray[np.float64]

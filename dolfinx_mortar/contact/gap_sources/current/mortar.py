@@ -102,6 +102,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
             raise ValueError("slave and master must share one displacement space (one mesh)")
         super().__init__(slave, kind, law)
         self.master, self.search_radius = master, search_radius
+        #: the slave surface is its own master (pairs without a facet's neighbours)
+        self.self_contact = master is slave
         # both surfaces relative to the slave's origin (CurrentSurfaceGap.origin)
         self._local_slave, self._local_master = slave.moved(-self.origin), master.moved(
             -self.origin)
@@ -172,7 +174,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
                                   facet_search_factor=(FACET_SEARCH_FACTOR
                                                        if self.search_radius is None
                                                        else None),
-                                  keep_points=self.pointwise)
+                                  keep_points=self.pointwise, self_contact=self.self_contact)
         all_cells = slave.cells[coupling.pairs[:, 0]]
         # the values of every pair from the double kernel; derivatives only
         # where a node may carry contact force or stiffness

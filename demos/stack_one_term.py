@@ -1,0 +1,76 @@
+"""Several bodies under one contact term: a stack of three blocks on a rigid plane.
+
+Three gmsh blocks of one mesh, [0, 1] wide, meshed with 0.05, 0.04 and 0.03 (non-matching at
+their interfaces), stand on the rigid plane y = 0; a uniform traction q presses the top one
+down (plane strain, small-strain elasticity in UFL, the left edges on a symmetry line). One
+term holds the ground contact; ONE self-contact term holds both interfaces between the blocks,
+given as the list of their four faces' tags: nobody says which face is slave or master, and
+the pairs between the blocks are found by the search (docs/SELF_CONTACT.md). Every interface
+carries the uniform pressure q, to round-off (a patch test). Run:
+``python3 demos/stack_one_term.py [--json F]`` (or with ``mpirun -n 2``).
+"""
+import argparse
+import json
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidPlane
+from demo_support.stack import stacked_blocks
+
+# blocks (x0, x1, y0, y1, mesh size), bottom to top; facet tags of their faces
+BLOCKS = [(0.0, 1.0, 0.0, 0.25, 0.05), (0.0, 1.0, 0.25, 0.5, 0.04), (0.0, 1.0, 0.5, 0.75, 0.03)]
+BOTTOM = (1, 2, 3)           # each block's bottom face
+TOP = (4, 5, 6)              # each block's top face (the last one is loaded)
+LEFT = 7                     # the left edges: u_x = 0
+q = 0.01                     # the traction on the top block's top face
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", help="write the figures to this file")
+    args = parser.parse_args(argv)
+    comm = MPI.COMM_WORLD
+    mesh, facet_tags = stacked_blocks(comm, BLOCKS, BOTTOM, TOP, LEFT)
+    V = fem.functionspace(mesh, ("Lagrange", 1, (2,)))
+    u, v = fem.Function(V, name="u"), ufl.TestFunction(V)
+    E, nu = 1.0, 0.3
+    mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+    eps = ufl.sym(ufl.grad(u))
+    ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
+    F = (ufl.inner(2 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(2), ufl.grad(v)) * ufl.dx
+         + q * v[1] * ds(TOP[2]))
+    left = fem.locate_dofs_topological(V.sub(0), 1, facet_tags.find(LEFT))
+    bcs = [fem.dirichletbc(0.0, left, V.sub(0))]
+    penalty = 1e3 * E / 0.03
+    ground = ContactTerm(u, facet_tags, BOTTOM[0], obstacle=RigidPlane([0, 0], [0, 1]),
+                         kind="LcLS*", penalty=penalty, name="ground")
+    interfaces = ContactTerm(u, facet_tags, [TOP[0], BOTTOM[1], TOP[1], BOTTOM[2]],
+                             self_contact=True, kind="LcLS*", penalty=penalty, name="blocks")
+    problem = NonlinearContactProblem(F, u, [ground, interfaces], bcs)
+    result = LoadPathSolver(problem).solve(lambda t: None, load_steps=1)
+    pressures = interfaces.results.surface_pressure(gather=True)
+    on_faces = pressures.x[:, 1] > 0.0                 # every node of the four faces
+    figures = {
+        "newton_iterations": result.newton_iterations,
+        "ground_force": float(ground.results.contact_force()[1]), "load": q,
+        "interface_pressure_min": float(pressures.p[on_faces].min()),
+        "interface_pressure_max": float(pressures.p[on_faces].max()),
+        "interface_nodes": int(on_faces.sum()),
+        "internal_force": float(np.linalg.norm(interfaces.results.contact_force())),
+    }
+    if comm.rank == 0:
+        print(f"{figures['newton_iterations']} Newton iterations; ground force "
+              f"{figures['ground_force']:.10g} for the load {q}; pressure on the "
+              f"{figures['interface_nodes']} interface nodes {figures['interface_pressure_min']:.10g}"
+              f" … {figures['interface_pressure_max']:.10g}")
+        if args.json:
+            with open(args.json, "w") as f:
+                json.dump(figures, f, indent=1)
+    return figures
+
+
+if __name__ == "__main__":
+    main()

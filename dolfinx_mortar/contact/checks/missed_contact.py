@@ -1,0 +1,130 @@
+"""Contact that the pairs missed: slave nodes that passed through the master
+while the term saw nothing there (issue 37).
+
+Against an elastic master the pairs are searched within a radius of the slave
+facets, in the configuration the bases are built in (the reference one with
+``basis_configuration="initial"``, where a step starts with ``"previous"``).
+Two faces that start further apart than that radius were never paired: the
+contact force stayed exactly 0 and the bodies passed through each other
+without a word. After each converged step the surfaces are therefore searched
+again in the current geometry, with a radius that covers their motion since
+the bases were built (where the surfaces moved by less than half the radius
+relative to each other, nothing can have been missed, and nothing is searched);
+a slave node that lies behind the master by more than
+:data:`MISSED_DEPTH` of its element length while the term carries no pressure
+there is contact the pairs missed. The term then rebuilds its bases with a
+radius that covers the motion and the step is solved again (logged).
+"""
+from __future__ import annotations
+
+import logging
+import warnings
+from typing import Optional
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.mortar.coupling import MortarCoupling
+from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
+from dolfinx_mortar.tolerance import NEAR_CONTACT
+
+logger = logging.getLogger("dolfinx_mortar.contact.checks")
+
+#: a slave node this many of its element lengths behind the master, where the term carries
+#: no pressure, is contact the pairs missed (a node at the edge of the contact zone lies
+#: behind the master by round-off and the linearization of frozen bases only)
+MISSED_DEPTH = NEAR_CONTACT
+#: times the radius is widened for missed contact before the check only warns
+MAX_MISSED_WIDENINGS = 4
+
+
+class MissedContact:
+    """The check of one contact term against an elastic master (see the module).
+
+    Parameters
+    ----------
+    term
+        The contact term (:class:`~dolfinx_mortar.contact.term.ContactTerm`).
+    configuration
+        Its configuration: where its bases were built.
+    """
+
+    def __init__(self, term, configuration):
+        self.term, self.configuration = term, configuration
+        self.widenings = 0
+        self._warned = False
+
+    def motion(self) -> float:
+        """The largest displacement of a slave or master node since the bases
+        were built, over all ranks (0 with nothing to compare)."""
+        term = self.term
+        if self.configuration.follows_u:   # the pairs are searched where the surfaces are
+            return 0.0
+        built = self.configuration.built_vector
+        if built is None:
+            relative = term.u
+        else:
+            relative = fem.Function(term.u.function_space)
+            relative.x.petsc_vec.waxpy(-1.0, built, term.u.x.petsc_vec)
+            relative.x.scatter_forward()
+        local = max(float(np.max(np.abs(nodal_displacement(surface, relative)), initial=0.0))
+                    for surface in (term.slave, term.master))
+        return term.comm.allreduce(local, op=MPI.MAX)
+
+    def missed(self, state: ContactState, radius: float) -> tuple[int, tuple[float, float, list]]:
+        """The slave nodes behind the master in the current geometry, searched
+        within ``radius``, where the term carries no pressure: their number
+        and the deepest (in element lengths, as a length, where; collective)."""
+        term = self.term
+        moved = [nodal_displacement(surface, term.u) for surface in (term.slave, term.master)]
+        probe = MortarCoupling(term.slave, term.master, *moved, search_radius=radius,
+                               self_contact=term.options.self_contact)
+        gap = probe.operators("LmLS*").nodal_gap()          # ∫N_A d over the covered part
+        covered = probe.covered_element_mass()[2]           # ∫_cov N_A
+        depth = np.full(len(covered), -np.inf)
+        np.divide(gap, covered, out=depth, where=covered > 0)
+        carried = term.results.nodal_pressures(state) > 0
+        lengths = term.results.node_lengths()
+        missed = (depth > MISSED_DEPTH * lengths) & ~carried
+        n = term.slave.layout.num_owned
+        count = term.comm.allreduce(int(np.sum(missed[:n])))
+        return count, term.results.deepest(np.where(missed, depth, -np.inf))
+
+    def wider_radius(self, state: ContactState) -> Optional[float]:
+        """After a converged step: the search radius the bases need where
+        contact was missed (:meth:`missed`), None where none was (collective)."""
+        term = self.term
+        if term.master is None or self._warned:
+            return None
+        coupling = self.configuration.segmentation(term.source)
+        # the current surface's own radius is not kept: twice its largest element
+        radius = (coupling.search_radius if coupling is not None
+                  else 2.0 * term.comm.allreduce(float(np.max(term.results.node_lengths(),
+                                                               initial=0.0)), op=MPI.MAX))
+        motion = self.motion()
+        if 2.0 * motion <= radius:
+            # no slave node can have reached a master facet that lay beyond the
+            # radius when the pairs were searched: nothing to search again
+            return None
+        reach = radius + 2.0 * motion
+        count, (ratio, depth, where) = self.missed(state, reach)
+        if count == 0:
+            return None
+        if self.widenings >= MAX_MISSED_WIDENINGS:
+            self._warned = True
+            warnings.warn(f"{count} slave node(s) passed through the master outside the "
+                          f"pairs (deepest {depth:.3g}, {ratio:.3g} element lengths, at "
+                          f"{where}) after {self.widenings} wider searches: the contact "
+                          "misses them. Pass a larger search_radius or smaller load steps",
+                          RuntimeWarning, stacklevel=4)
+            return None
+        self.widenings += 1
+        wider = max(4.0 * radius, reach)
+        if term.comm.rank == 0:
+            logger.info("%d slave node(s) passed through the master outside the pairs "
+                        "(deepest %.3g, %.3g element lengths, at %s): bases rebuilt with the "
+                        "search radius %.3g (was %.3g), step solved again", count, depth,
+                        ratio, where, wider, radius)
+        return wider

@@ -1,0 +1,73 @@
+"""Self-contact: a surface that is its own master, in two passes
+(docs/SELF_CONTACT.md).
+
+Every node of the surface is a slave node with its own mortar gap against the
+rest of the surface, whose facet neighbours are excluded from the pairs
+(:func:`~dolfinx_mortar.mortar.facet_search.near_in_surface`). Each contact
+is so seen twice, once from either side, and the potential is the mean of the
+two passes, ``Π = ½ Σ_A (ω_A/2)⟨d̄_A⟩²`` over all nodes of the surface: no side
+is preferred, and the answer does not depend on which one the user would have
+called slave. Where the two sides are mirror images, each pass carries half
+the force and the traction on either side is ``ε⟨d̄_A⟩``, the single-pass
+pressure of a slave–master pair with the same penalty; the nodal pressure
+reported at a node is that of its own gap, ``ε⟨d̄_A⟩``.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+from petsc4py import PETSc
+
+from dolfinx_mortar.contact.gap_sources.current import CurrentMortarGap
+from dolfinx_mortar.contact.gap_sources.frozen import MortarGap
+from dolfinx_mortar.contact.laws import PenaltyLaw
+from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.kinds import BasisKind
+from dolfinx_mortar.mortar.coupling import MortarCoupling
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def half_penalty(law: PenaltyLaw) -> PenaltyLaw:
+    """Each pass's law: the mean of the two passes is each with half the penalty."""
+    return replace(law, penalty=law.penalty / 2)
+
+
+class TwoPassPressures:
+    """The pressures of a two-pass source with the whole penalty (mixed into a
+    source built with :func:`half_penalty`)."""
+
+    def nodal_pressures(self, state: ContactState) -> FloatArray:
+        """``p_A = ε⟨d̄_A⟩``: the pressure of the node's own gap with the whole penalty."""
+        return 2.0 * super().nodal_pressures(state)
+
+    def mortar_traction(self, state: ContactState) -> FloatArray:
+        """The traction of the node's own pass with the whole penalty."""
+        return 2.0 * super().mortar_traction(state)
+
+
+class SelfContactGap(TwoPassPressures, MortarGap):
+    """The frozen mortar gaps of a surface against itself, two-pass (see the module).
+
+    Parameters as for :class:`~dolfinx_mortar.contact.gap_sources.frozen.MortarGap`;
+    ``coupling`` must pair the surface with itself without neighbours
+    (``MortarCoupling(surface, surface, self_contact=True)``).
+    """
+
+    def __init__(self, coupling: MortarCoupling, law: PenaltyLaw,
+                 reference: Optional[PETSc.Vec] = None, boundary_modification: bool = False):
+        super().__init__(coupling, half_penalty(law), reference, boundary_modification)
+
+
+class CurrentSelfContactGap(TwoPassPressures, CurrentMortarGap):
+    """The same on the current surface, exactly linearized (parameters as for
+    :class:`~dolfinx_mortar.contact.gap_sources.current.CurrentMortarGap`, with
+    the slave surface as its own master)."""
+
+    def __init__(self, surface: LagrangeSurface, kind: BasisKind, law: PenaltyLaw,
+                 search_radius: Optional[float] = None):
+        super().__init__(surface, surface, kind, half_penalty(law), search_radius)
