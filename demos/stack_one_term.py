@@ -19,6 +19,7 @@ from mpi4py import MPI
 
 from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidPlane
 from demo_support.stack import stacked_blocks
+from dolfinx_mortar.small_strain.elastic import linear_elastic_residual
 
 # blocks (x0, x1, y0, y1, mesh size), bottom to top; facet tags of their faces
 BLOCKS = [(0.0, 1.0, 0.0, 0.25, 0.05), (0.0, 1.0, 0.25, 0.5, 0.04), (0.0, 1.0, 0.5, 0.75, 0.03)]
@@ -36,12 +37,9 @@ def main(argv=None) -> dict:
     mesh, facet_tags = stacked_blocks(comm, BLOCKS, BOTTOM, TOP, LEFT)
     V = fem.functionspace(mesh, ("Lagrange", 1, (2,)))
     u, v = fem.Function(V, name="u"), ufl.TestFunction(V)
-    E, nu = 1.0, 0.3
-    mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
-    eps = ufl.sym(ufl.grad(u))
+    E = 1.0
     ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
-    F = (ufl.inner(2 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(2), ufl.grad(v)) * ufl.dx
-         + q * v[1] * ds(TOP[2]))
+    F = linear_elastic_residual(u, E, 0.3) + q * v[1] * ds(TOP[2])
     left = fem.locate_dofs_topological(V.sub(0), 1, facet_tags.find(LEFT))
     bcs = [fem.dirichletbc(0.0, left, V.sub(0))]
     penalty = 1e3 * E / 0.03

@@ -18,6 +18,7 @@ from mpi4py import MPI
 
 from dolfinx_mortar.contact.checks.missed_contact import MissedContact
 from dolfinx_mortar.contact.checks.setup_checks import (check_initial_overlap,
+                                                        refuse_a_self_overlap,
                                                         warn_if_the_obstacle_faces_away)
 from dolfinx_mortar.contact.checks.thresholds import (BODY_PENETRATION, DEEP_PENETRATION,
                                                       MAX_RADIUS_WIDENINGS, PENALTY_PENETRATION,
@@ -119,13 +120,8 @@ class RangeChecks:
         on_local_cell[slave.cells] = True
         covered = state.covered & on_local_cell
         ratio, gap, x = self.term.results.deepest(np.where(covered, state.gaps, -np.inf))
-        if ratio > DEEP_PENETRATION and self.term.options.self_contact:
-            raise ValueError(f"the surface overlaps itself at the start: the node {x} lies "
-                             f"{gap:.3g} ({ratio:.3g} element lengths) inside the body's own "
-                             "surface. A self-contact surface must start without overlaps: "
-                             "check the geometry and the tag; or a wall of the body thinner "
-                             "than the search radius pairs with its own other side through "
-                             "the material: pass a search_radius below the wall's thickness")
+        if self.term.options.self_contact:
+            refuse_a_self_overlap(ratio, gap, x)
         if ratio > DEEP_PENETRATION:
             hint = ""
             options = self.term.options

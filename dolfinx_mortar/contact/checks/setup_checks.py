@@ -88,6 +88,19 @@ def check_initial_overlap(term, coupling, built_at_u: bool) -> None:
         return
 
 
+def refuse_a_self_overlap(ratio: float, depth: float, where: list) -> None:
+    """A self-contact surface whose deepest node (``ratio`` element lengths, ``depth``,
+    at ``where``; the same on every rank) lies more than DEEP_PENETRATION inside the
+    body at the start is refused: with two bodies it is warned about only."""
+    if ratio > DEEP_PENETRATION:
+        raise ValueError(f"the surface overlaps itself at the start: the node {where} lies "
+                         f"{depth:.3g} ({ratio:.3g} element lengths) inside the body's own "
+                         "surface. A self-contact surface must start without overlaps: "
+                         "check the geometry and the tag; or a wall of the body thinner "
+                         "than the search radius pairs with its own other side through "
+                         "the material: pass a search_radius below the wall's thickness")
+
+
 #: a penalty below this many times E/h is refused where E is known
 #: (:class:`~dolfinx_mortar.small_strain.elastic.ContactProblem`): at a strain
 #: of 1e-3 it lets the bodies pass through each other by 1e5 element lengths
