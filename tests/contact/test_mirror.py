@@ -129,7 +129,12 @@ def test_the_mirror_converges_under_refinement_in_the_initial_configuration(capl
         assert any("bases rebuilt with" in r.getMessage() for r in caplog.records)
 
 
-def test_a_search_radius_the_user_gave_is_kept_and_warned_about():
-    with pytest.warns(RuntimeWarning, match="found no master within the search radius 0.005"):
-        cut = mirror(80, PRESSED, penalty=8e4, search_radius=0.005)
-    assert cut.pressure_difference > 0.1
+def test_a_search_radius_the_user_gave_that_misses_contact_is_widened_with_a_warning():
+    """A radius of 0.005 on a mesh graded to h = a/80: slave nodes pass through
+    the master beyond it. It was kept with a warning and the pressure was cut
+    off (> 10% off the mirror); contact that the pairs miss is now never kept:
+    the bases are rebuilt with a radius that covers the motion, and as the user
+    chose the radius, it is a warning (measured: 8.9e-5 off the mirror)."""
+    with pytest.warns(RuntimeWarning, match="search radius 0.005 that was given missed contact"):
+        result = mirror(80, PRESSED, penalty=8e4, search_radius=0.005)
+    assert_mirror(result)

@@ -53,6 +53,8 @@ class MissedContact:
 
     def __init__(self, term, configuration):
         self.term, self.configuration = term, configuration
+        #: the radius the user gave (None: the default), which a widening overrides loudly
+        self.given_radius = term.options.search_radius
         self.widenings = 0
         self._warned = False
 
@@ -122,6 +124,12 @@ class MissedContact:
             return None
         self.widenings += 1
         wider = max(4.0 * radius, reach)
+        if self.widenings == 1 and self.given_radius is not None:
+            warnings.warn(f"the search radius {self.given_radius:.3g} that was given missed "
+                          f"contact: {count} slave node(s) passed through the master outside "
+                          f"the pairs (deepest {depth:.3g} at {where}); the bases are rebuilt "
+                          f"with {wider:.3g} and the step solved again",
+                          RuntimeWarning, stacklevel=4)
         if term.comm.rank == 0:
             logger.info("%d slave node(s) passed through the master outside the pairs "
                         "(deepest %.3g, %.3g element lengths, at %s): bases rebuilt with the "

@@ -296,8 +296,9 @@ class RangeChecks:
         outside the pairs (:class:`~dolfinx_mortar.contact.checks.missed_contact.MissedContact`;
         collective)."""
         state = state or self.term.evaluate()
-        radius = self.radius_reached(state)
-        return radius if radius is not None else self.missed.wider_radius(state)
+        # contact the pairs missed first: it overrides even a radius the user gave
+        radius = self.missed.wider_radius(state)
+        return radius if radius is not None else self.radius_reached(state)
 
     def radius_reached(self, state: Optional[ContactState] = None) -> Optional[float]:
         """After a converged step: where the contact zone reached slave nodes
