@@ -92,9 +92,16 @@ def near_in_surface(slave: LagrangeSurface, master_copy: SurfaceCopy,
     has moved. ``master_copy`` must be the surface itself, gathered.
     """
     import scipy.sparse
+    size = slave.layout.size_global
+    # collective, before a rank without candidates returns: every rank gathers
+    volume = gathered = None
+    if slave.volume_nodes is not None:
+        volume = slave.layout.global_indices[slave.volume_nodes]
+        comm = slave.layout.comm
+        gathered = np.concatenate(comm.allgather(volume)).reshape(-1, volume.shape[1]) \
+            if comm.size > 1 else volume
     if len(candidates) == 0:
         return np.zeros(0, dtype=bool)
-    size = slave.layout.size_global
 
     def incidence(global_nodes: npt.NDArray) -> "scipy.sparse.csr_matrix":
         rows = np.repeat(np.arange(len(global_nodes)), global_nodes.shape[1])
@@ -106,12 +113,8 @@ def near_in_surface(slave: LagrangeSurface, master_copy: SurfaceCopy,
     near = S @ M.T                     # share a node
     for _ in range(rings - 1):
         near = near @ (M @ M.T)        # … or share one with a facet that does
-    if slave.volume_nodes is not None:
+    if volume is not None:
         # … or bound cells that share one (the gathered copy is in rank order)
-        volume = slave.layout.global_indices[slave.volume_nodes]
-        comm = slave.layout.comm
-        gathered = np.concatenate(comm.allgather(volume)).reshape(-1, volume.shape[1]) \
-            if comm.size > 1 else volume
         near = near + incidence(volume) @ incidence(gathered).T
     values = np.asarray(near[candidates[:, 0], candidates[:, 1]]).ravel()
     return values > 0

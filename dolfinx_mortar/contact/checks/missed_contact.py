@@ -62,8 +62,6 @@ class MissedContact:
         """The largest displacement of a slave or master node since the bases
         were built, over all ranks (0 with nothing to compare)."""
         term = self.term
-        if self.configuration.follows_u:   # the pairs are searched where the surfaces are
-            return 0.0
         built = self.configuration.built_vector
         if built is None:
             relative = term.u
@@ -98,7 +96,9 @@ class MissedContact:
         """After a converged step: the search radius the bases need where
         contact was missed (:meth:`missed`), None where none was (collective)."""
         term = self.term
-        if term.master is None or self._warned:
+        # on the current surface the pairs are searched where the surfaces are, at every
+        # evaluation: nothing was built elsewhere to miss contact from
+        if term.master is None or self._warned or self.configuration.follows_u:
             return None
         coupling = self.configuration.segmentation(term.source)
         # the current surface's own radius is not kept: twice its largest element
