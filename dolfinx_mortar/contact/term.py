@@ -114,7 +114,7 @@ class ContactTerm:
         # one decision of all ranks: an argument bad on one rank only raises on every rank
         with collective_checks(communicator_of(u)):
             check_contact_arguments(u, master_tag, obstacle, axisymmetric, self_contact)
-            check_tangential_law(friction, self_contact)
+            check_tangential_law(friction)
             #: the name of the term's output (None: from the slave tag)
             self.name: Optional[str] = check_term_name(name)
             options = ContactOptions.checked(

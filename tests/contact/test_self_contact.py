@@ -155,7 +155,6 @@ def test_a_surface_pairs_with_itself_only_away_from_its_neighbours_and_face_to_f
     ({"master_tag": 3}, ValueError, "self_contact=True takes no master_tag"),
     ({"obstacle": RigidPlane([0.0, 0.0], [0.0, 1.0])}, ValueError, "takes no master_tag"),
     ({"kind": "GLS"}, NotImplementedError, "GLS kind"),
-    ({"friction": CoulombFriction(0.3)}, NotImplementedError, "friction with self_contact"),
     ({"kind": "LcLS*", "active_set": "pointwise"}, NotImplementedError, "dual kind"),
 ])
 def test_what_self_contact_refuses_is_named(arguments, error, match):

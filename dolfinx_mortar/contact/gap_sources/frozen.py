@@ -54,6 +54,17 @@ def dof_layout(nodes: NodeLayout, bs: int) -> NodeLayout:
     return NodeLayout(nodes.comm, nodes.num_owned * bs, ghosts)
 
 
+def tangential_tractions(law: PenaltyLaw, state: ContactState) -> FloatArray:
+    """``q_A = −f_T,A / W_A^k`` of the friction forces of ``state``, (nodes, gdim)."""
+    force = -state.friction.mapping.force
+    if law.k == 0:
+        return force.copy()
+    q = np.zeros_like(force)
+    W = state.lumped_weights
+    np.divide(force, W[:, None], out=q, where=(W > 0)[:, None])
+    return q
+
+
 class GapSourceBase:
     """Shared state: the slave surface, the gap basis and the node weights ω,
     and what the models with frozen bases share of
@@ -64,7 +75,6 @@ class GapSourceBase:
     coupling = None
     #: the slip operator is made again at every load step (False: once per source)
     slip_operator_per_step = False
-
     def __init__(self, slave: LagrangeSurface, law: PenaltyLaw):
         self.slave = slave
         self.law = law
@@ -98,6 +108,11 @@ class GapSourceBase:
         <dolfinx_mortar.contact.laws.penalty.PenaltyLaw.pressure>`)."""
         return self.law.pressure(state.weights, state.lumped_weights, state.gaps,
                                  state.gaps_plus)
+
+    def tangential_tractions(self, state: ContactState) -> FloatArray:
+        """``q_A = −f_T,A / W_A^k``, the coefficients of the tangential traction
+        on the slave body, as ``p_A`` is of the pressure."""
+        return tangential_tractions(self.law, state)
 
     def mortar_traction(self, state: ContactState) -> FloatArray:
         """``p* = Σ_A f_A M_A`` at the nodes of every slave cell, (cells, nodes)."""

@@ -15,7 +15,7 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar.bases.basis import MortarBasis
-from dolfinx_mortar.contact.gap_sources.frozen import GapSourceBase
+from dolfinx_mortar.contact.gap_sources.frozen import GapSourceBase, tangential_tractions
 from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
 from dolfinx_mortar.contact.state import ContactState
@@ -110,6 +110,10 @@ class GlobalGap:
         coefficients of the traction in the PU basis GLS*."""
         return self.law.pressure(state.weights, state.lumped_weights, state.gaps,
                                  state.gaps_plus)
+
+    def tangential_tractions(self, state: ContactState) -> FloatArray:
+        """``q_A = −f_T,A / W_A^k`` (as the frozen sources)."""
+        return tangential_tractions(self.law, state)
 
     def mortar_traction(self, state: ContactState) -> FloatArray:
         """``p* = Σ_A f_A (N L⁻¹)_A = Σ_B N_B z_B`` at the nodes of every slave cell."""

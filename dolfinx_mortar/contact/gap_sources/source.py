@@ -71,6 +71,10 @@ class GapSource(Protocol):
     def mortar_traction(self, state: ContactState) -> FloatArray:
         """The traction's values at the nodes of every slave cell, (cells, nodes)."""
 
+    def tangential_tractions(self, state: ContactState) -> FloatArray:
+        """The tangential traction ``q_A`` on node A's body at a state with
+        friction, (nodes, gdim)."""
+
     def normal_force_derivative(self, state: ContactState, active: FloatArray) -> PETSc.Mat:
         """``∂f_N/∂u`` of the nodal normal forces (slave nodes × dofs), ``active`` as H."""
 

@@ -98,12 +98,8 @@ class NormalLaw(Protocol):
         """The pointwise set's virtual work coefficients and their derivatives."""
 
 
-def check_tangential_law(friction: object, self_contact: bool = False) -> None:
-    """TypeError unless ``friction`` implements :class:`TangentialLaw` (or is None);
-    NotImplementedError for friction in self-contact."""
-    if friction is not None and self_contact:
-        raise NotImplementedError("friction with self_contact=True: the slip of a surface "
-                                  "against itself is not measured yet")
+def check_tangential_law(friction: object) -> None:
+    """TypeError unless ``friction`` implements :class:`TangentialLaw` (or is None)."""
     if friction is not None and not isinstance(friction, TangentialLaw):
         raise TypeError(f"friction must be a friction law such as CoulombFriction (with "
                         f"penalty() and return_mapping()), or None; got "

@@ -71,13 +71,8 @@ class FrictionResults:
         the slave's slip relative to what it touches, and ``|q_A| ≤ μ p_A``.
         With the nodes' coordinates: :meth:`surface_friction`."""
         state = state or self.term.evaluate()
-        W = state.lumped_weights
-        force = -self._friction(state).mapping.force
-        if self.term.options.law.k == 0:
-            return force.copy()
-        q = np.zeros_like(force)
-        np.divide(force, W[:, None], out=q, where=(W > 0)[:, None])
-        return q
+        self._friction(state)
+        return self.term.source.tangential_tractions(state)
 
     def slip_states(self, state: Optional[ContactState] = None) -> npt.NDArray[np.int8]:
         """Per local slave-layout node: 0 separated, 1 stick, 2 slip

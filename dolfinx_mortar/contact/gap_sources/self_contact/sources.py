@@ -9,12 +9,12 @@ two passes, ``Π = ½ Σ_A (ω_A/2)⟨d̄_A⟩²`` over all nodes of the surface
 is preferred, and the answer does not depend on which one the user would have
 called slave. Where the two sides are mirror images, each pass carries half
 the force and the traction on either side is ``ε⟨d̄_A⟩``, the single-pass
-pressure of a slave–master pair with the same penalty; the nodal pressure
-reported at a node is that of its own gap, ``ε⟨d̄_A⟩``.
+pressure of a slave–master pair with the same penalty. What a node reports
+is the traction its body receives from both passes
+(:class:`~dolfinx_mortar.contact.gap_sources.self_contact.two_pass.TwoPassPressures`).
 """
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Optional
 
 import numpy as np
@@ -23,31 +23,16 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact.gap_sources.current import CurrentMortarGap
 from dolfinx_mortar.contact.gap_sources.frozen import MortarGap
+from dolfinx_mortar.contact.gap_sources.self_contact.two_pass import (TwoPassPressures,
+                                                                      half_penalty)
 from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.mortar.coupling import MortarCoupling
+from dolfinx_mortar.mortar.surface_normals import averaged_nodal_normals
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
 FloatArray = npt.NDArray[np.float64]
-
-
-def half_penalty(law: PenaltyLaw) -> PenaltyLaw:
-    """Each pass's law: the mean of the two passes is each with half the penalty."""
-    return replace(law, penalty=law.penalty / 2)
-
-
-class TwoPassPressures:
-    """The pressures of a two-pass source with the whole penalty (mixed into a
-    source built with :func:`half_penalty`)."""
-
-    def nodal_pressures(self, state: ContactState) -> FloatArray:
-        """``p_A = ε⟨d̄_A⟩``: the pressure of the node's own gap with the whole penalty."""
-        return 2.0 * super().nodal_pressures(state)
-
-    def mortar_traction(self, state: ContactState) -> FloatArray:
-        """The traction of the node's own pass with the whole penalty."""
-        return 2.0 * super().mortar_traction(state)
 
 
 class SelfContactGap(TwoPassPressures, MortarGap):
@@ -62,6 +47,11 @@ class SelfContactGap(TwoPassPressures, MortarGap):
                  reference: Optional[PETSc.Vec] = None, boundary_modification: bool = False):
         super().__init__(coupling, half_penalty(law), reference, boundary_modification)
 
+    def _node_geometry(self, state: ContactState) -> tuple[FloatArray, FloatArray]:
+        """The segmentation's nodal normals and ``W_A = ∫ N_A`` over the whole
+        surface (frozen with the bases; not the covered part's)."""
+        return self.coupling.normals, self.basis.lumped_weights
+
 
 class CurrentSelfContactGap(TwoPassPressures, CurrentMortarGap):
     """The same on the current surface, exactly linearized (parameters as for
@@ -71,3 +61,9 @@ class CurrentSelfContactGap(TwoPassPressures, CurrentMortarGap):
     def __init__(self, surface: LagrangeSurface, kind: BasisKind, law: PenaltyLaw,
                  search_radius: Optional[float] = None):
         super().__init__(surface, surface, kind, half_penalty(law), search_radius)
+
+    def _node_geometry(self, state: ContactState) -> tuple[FloatArray, FloatArray]:
+        """The averaged nodal normals and ``W_A`` of the current surface at ``state``."""
+        x = np.zeros((self.slave.layout.size_local, self.slave.gdim))
+        x[self.slave.cells] = state.data.x
+        return averaged_nodal_normals(self.slave, x), state.lumped_weights
