@@ -31,7 +31,8 @@ from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
-from dolfinx_mortar.mortar.facet_search import candidate_pairs, near_in_surface
+from dolfinx_mortar.mortar.facet_search import candidate_pairs, near_in_surface, search_boxes
+from dolfinx_mortar.mortar.surface_exchange import NearSurface, largest_facet, whole_surface
 # the surfaces' geometry lives in surface_normals; these names stay importable here
 from dolfinx_mortar.mortar.surface_normals import (  # noqa: F401
     SurfaceCopy, averaged_nodal_normals, cluster_diameters, current_coordinates,
@@ -78,8 +79,8 @@ class MortarCoupling:
     Parameters
     ----------
     slave, master
-        The surfaces; the slave's cells must be owned by this rank, the master
-        is gathered from all ranks.
+        The surfaces; the slave's cells must be owned by this rank; of the
+        master, each rank receives the facets its slave facets may reach.
     slave_displacement, master_displacement
         Nodal displacements (local nodes, gdim) giving the configuration;
         ``None`` means the surfaces' own coordinates.
@@ -113,6 +114,11 @@ class MortarCoupling:
         ``master`` is ``slave`` (a surface that may touch itself): pairs of facets
         that are neighbours on the surface are never candidates
         (:func:`~dolfinx_mortar.mortar.facet_search.near_in_surface`).
+    whole_master
+        Gather every rank's master facets on every rank (what the current
+        configuration's shared-out Jet work needs), instead of only those the
+        slave facets' search boxes meet, with a band of the largest master
+        facet (:class:`~dolfinx_mortar.mortar.surface_exchange.NearSurface`).
 
     Raises
     ------
@@ -129,7 +135,8 @@ class MortarCoupling:
                  quadrature_degree: Optional[int] = None,
                  opposing_normals_only: bool = True, keep_points: bool = False,
                  facet_search_factor: Optional[float] = None,
-                 interface_normals: bool = False, self_contact: bool = False):
+                 interface_normals: bool = False, self_contact: bool = False,
+                 whole_master: bool = False):
         if slave.gdim != master.gdim:
             raise ValueError(f"slave ({slave.gdim}D) and master ({master.gdim}D) surfaces "
                              "live in different dimensions")
@@ -148,17 +155,23 @@ class MortarCoupling:
         xm = current_coordinates(master, master_displacement)
         clusters = normal_clusters(slave, xs)
         self.normals = averaged_nodal_normals(slave, xs, clusters)
-        master_copy = gather_surface(master, xm)
+        slave_cells = slave.cells.astype(np.int32)
+        self.search_radius, slave_boxes = search_boxes(
+            slave, xs, slave_cells, clusters, search_radius, facet_search_factor)
+        if whole_master:
+            master_copy, self.received_bytes = whole_surface(master, xm)
+        else:
+            near = NearSurface(master, xm, slave_boxes, largest_facet(master, xm))
+            master_copy, self.received_bytes = near.copy, near.received_bytes
         self.timings["normals_and_gather"] = time.perf_counter() - clock
         clock = time.perf_counter()
-        #: the gathered master surface (all ranks' cells, one node copy per cell)
+        #: the master facets this rank's slave facets may reach, with a band
+        #: (all ranks' with ``whole_master``), one node copy per cell; and the
+        #: bytes this rank received for them from the other ranks
         self.master_copy = master_copy
         self.master_global_ids = master_copy.global_ids
         self.master_cells = master_copy.cells
-
-        slave_cells = slave.cells.astype(np.int32)
-        self.search_radius, candidates = candidate_pairs(
-            slave, xs, slave_cells, clusters, master_copy, search_radius, facet_search_factor)
+        candidates = candidate_pairs(slave_boxes, master_copy)
         if self_contact:
             # a surface against itself: a facet's neighbours are never its partners
             candidates = candidates[~near_in_surface(slave, master_copy, candidates)]
@@ -168,10 +181,9 @@ class MortarCoupling:
                                        + max(polynomial_degree(slave),
                                              polynomial_degree(master)))
         points, weights = segment_quadrature(slave.tdim, degree)
-        #: the length scale of every geometric decision, the same on every rank
-        #: (the master copy is global, the slave's points are reduced)
+        #: the length scale of every geometric decision, reduced over the ranks
         self.length_scale = max(length_scale(xs, comm),
-                                length_scale(master_copy.x) if len(master_copy.x) else 0.0)
+                                length_scale(xm[np.unique(master.cells)], comm))
         #: lengths at or below this are zero (docs/DESIGN.md, §Tolerances)
         self.zero_length = zero_length(self.length_scale)
         def segment(normals: FloatArray, keep_points: bool,
@@ -227,11 +239,12 @@ class MortarCoupling:
         lines = [f"slave facet {c} (local cell index on rank {comm.rank}) with nodes "
                  f"{np.array2string(xs[slave_cells[c]], precision=17, separator=', ')}"
                  for c in r.degenerate_slave_facets[:5]]
-        lines = [line for rank_lines in comm.allgather(lines) for line in rank_lines]
-        # the master copy is the same on every rank: so is its list
-        lines += [f"master facet {c} (index in the gathered master surface) with nodes "
+        lines += [f"master facet with nodes "
                   f"{np.array2string(master_copy.x[master_copy.cells[c]], precision=17, separator=', ')}"
                   for c in r.degenerate_master_facets[:5]]
+        # a master facet near several ranks' slave facets is named once
+        lines = list(dict.fromkeys(line for rank_lines in comm.allgather(lines)
+                                   for line in rank_lines))
         if lines:
             raise DegenerateGeometryError(
                 f"degenerate contact facets (length or height at most the zero length "

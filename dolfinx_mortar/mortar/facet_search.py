@@ -10,17 +10,17 @@ from mpi4py import MPI
 
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.mortar.surface_normals import (SurfaceCopy, cluster_diameters,
-                                                   swept_facet_boxes)
+                                                   swept_facet_boxes, volume_ids)
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
 FloatArray = npt.NDArray[np.float64]
 
 
-def candidate_pairs(slave: LagrangeSurface, xs: FloatArray, slave_cells: npt.NDArray[np.int32],
-                    clusters: dict[int, int], master_copy: SurfaceCopy,
-                    search_radius: Optional[float],
-                    facet_search_factor: Optional[float]) -> tuple[float, npt.NDArray]:
-    """The slave–master facet pairs whose search boxes overlap.
+def search_boxes(slave: LagrangeSurface, xs: FloatArray, slave_cells: npt.NDArray[np.int32],
+                 clusters: dict[int, int], search_radius: Optional[float],
+                 facet_search_factor: Optional[float]) -> tuple[float, FloatArray]:
+    """Where each slave facet looks for master facets: the search radius and the
+    slave facets' search boxes (cells, 6: lower then upper corner).
 
     Collective when ``search_radius`` is None (its default is reduced over all ranks).
 
@@ -34,8 +34,6 @@ def candidate_pairs(slave: LagrangeSurface, xs: FloatArray, slave_cells: npt.NDA
         The slave cells' nodes, as the kernels take them (int32).
     clusters
         The slave nodes that share a normal (:func:`normal_clusters`).
-    master_copy
-        The master surface gathered from all ranks.
     search_radius
         How far along its normal a slave facet reaches; None: the largest slave
         facet diameter over all ranks.
@@ -46,8 +44,7 @@ def candidate_pairs(slave: LagrangeSurface, xs: FloatArray, slave_cells: npt.NDA
     Returns
     -------
     tuple
-        The search radius used and the candidate pairs (slave cell, master cell in
-        the gathered master).
+        The search radius used and the boxes.
 
     Raises
     ------
@@ -74,9 +71,14 @@ def candidate_pairs(slave: LagrangeSurface, xs: FloatArray, slave_cells: npt.NDA
         margin = facet_search_factor * diameters[:, None]
         slave_boxes[:, :3] -= margin
         slave_boxes[:, 3:] += margin
+    return search_radius, slave_boxes
+
+
+def candidate_pairs(slave_boxes: FloatArray, master_copy: SurfaceCopy) -> npt.NDArray:
+    """The pairs (slave cell, master cell of ``master_copy``) whose boxes overlap."""
     master_boxes = _kernels.facet_bounding_boxes(master_copy.facet_type, master_copy.x,
                                                  master_copy.cells, 0.0)
-    return search_radius, _kernels.overlapping_box_pairs(slave_boxes, master_boxes)
+    return _kernels.overlapping_box_pairs(slave_boxes, master_boxes)
 
 
 def near_in_surface(slave: LagrangeSurface, master_copy: SurfaceCopy,
@@ -89,17 +91,12 @@ def near_in_surface(slave: LagrangeSurface, master_copy: SurfaceCopy,
     distance, or bound a wall one or two cells thick, whose other side faces
     them through the material; they are never in contact with each other. The
     test is on global node numbers, so it does not depend on where the surface
-    has moved. ``master_copy`` must be the surface itself, gathered.
+    has moved. ``master_copy`` must be the surface itself (gathered, or the
+    part near this rank's facets with a band of at least one facet).
     """
     import scipy.sparse
     size = slave.layout.size_global
-    # collective, before a rank without candidates returns: every rank gathers
-    volume = gathered = None
-    if slave.volume_nodes is not None:
-        volume = slave.layout.global_indices[slave.volume_nodes]
-        comm = slave.layout.comm
-        gathered = np.concatenate(comm.allgather(volume)).reshape(-1, volume.shape[1]) \
-            if comm.size > 1 else volume
+    volume, received = volume_ids(slave), master_copy.volume_ids
     if len(candidates) == 0:
         return np.zeros(0, dtype=bool)
 
@@ -113,8 +110,8 @@ def near_in_surface(slave: LagrangeSurface, master_copy: SurfaceCopy,
     near = S @ M.T                     # share a node
     for _ in range(rings - 1):
         near = near @ (M @ M.T)        # … or share one with a facet that does
-    if volume is not None:
-        # … or bound cells that share one (the gathered copy is in rank order)
-        near = near + incidence(volume) @ incidence(gathered).T
+    if volume is not None and received is not None:
+        # … or bound cells that share one
+        near = near + incidence(volume) @ incidence(received).T
     values = np.asarray(near[candidates[:, 0], candidates[:, 1]]).ravel()
     return values > 0

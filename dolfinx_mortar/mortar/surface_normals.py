@@ -31,12 +31,17 @@ class SurfaceCopy:
         Node indices of each cell, (cells, nodes per cell).
     global_ids
         Global function index of each node in the surface's layout.
+    volume_ids
+        Per cell, the global indices (in the surface's layout) of the nodes of
+        the volume cell it bounds, where the surface knows them
+        (``LagrangeSurface.volume_nodes``); else None.
     """
 
     facet_type: _kernels.FacetType
     x: FloatArray
     cells: npt.NDArray[np.int32]
     global_ids: IntArray
+    volume_ids: Optional[IntArray] = None
 
 
 def current_coordinates(surface: LagrangeSurface,
@@ -255,17 +260,27 @@ def swept_facet_boxes(surface: LagrangeSurface, x: FloatArray, cells: npt.NDArra
 def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
     """All ranks' cells of a surface, with one copy of the nodes per cell.
 
-    The master side needs every master facet that may lie below this rank's
-    slave facets; gathering the (small) master surface is the simple way
-    (docs/DESIGN.md, §Parallel).
+    What the current configuration's shared-out Jet work needs: both surfaces,
+    the same on every rank. A frozen coupling receives only the master facets
+    near its slave facets (:class:`~dolfinx_mortar.mortar.surface_exchange.NearSurface`).
     """
     comm = surface.layout.comm
     global_ids = surface.layout.global_indices[surface.cells]
     coords = x[surface.cells]
+    volume = volume_ids(surface)
     if comm.size > 1:
         global_ids = np.concatenate(comm.allgather(global_ids)).reshape(-1, surface.cells.shape[1])
         coords = np.concatenate(comm.allgather(coords)).reshape(-1, *coords.shape[1:])
+        if volume is not None:
+            volume = np.concatenate(comm.allgather(volume)).reshape(-1, volume.shape[1])
     nc, nd = global_ids.shape
     return SurfaceCopy(surface.facet_type, coords.reshape(nc * nd, -1),
                        np.arange(nc * nd, dtype=np.int32).reshape(nc, nd),
-                       global_ids.ravel())
+                       global_ids.ravel(), volume)
+
+
+def volume_ids(surface: LagrangeSurface) -> Optional[IntArray]:
+    """The global indices of each local cell's volume cell nodes (None where unknown)."""
+    if surface.volume_nodes is None:
+        return None
+    return surface.layout.global_indices[surface.volume_nodes]

@@ -13,32 +13,8 @@ from scipy.spatial import cKDTree
 
 from dolfinx_mortar.surfaces.facet_surface import facet_surface, nodal_displacement
 from dolfinx_mortar.mortar.coupling import MortarCoupling
+from support.meshes import MASTER, SLAVE, two_blocks
 
-SLAVE, MASTER = 1, 2
-
-
-def two_blocks(comm, dim, degree):
-    """A lower block (slave face on top) and a coarser, shifted upper block."""
-    if dim == 2:
-        lower = mesh.create_rectangle(comm, [[0, -0.5], [1, 0]], [7, 3],
-                                      cell_type=mesh.CellType.triangle)
-        upper = mesh.create_rectangle(comm, [[0.3, 0.0], [1.4, 0.5]], [4, 2],
-                                      cell_type=mesh.CellType.quadrilateral)
-    else:
-        lower = mesh.create_box(comm, [[0, 0, -0.5], [1, 1, 0]], [5, 4, 2],
-                                cell_type=mesh.CellType.tetrahedron)
-        upper = mesh.create_box(comm, [[0.3, -0.2, 0], [1.4, 0.8, 0.5]], [3, 3, 2],
-                                cell_type=mesh.CellType.hexahedron)
-    out = []
-    for domain, tag, where in ((lower, SLAVE, 0.0), (upper, MASTER, 0.0)):
-        fdim = dim - 1
-        facets = mesh.locate_entities_boundary(domain, fdim,
-                                               lambda x: np.isclose(x[dim - 1], where))
-        tags = mesh.meshtags(domain, fdim, np.sort(facets).astype(np.int32),
-                             np.full(len(facets), tag, dtype=np.int32))
-        V = fem.functionspace(domain, ("Lagrange", degree, (domain.geometry.dim,)))
-        out.append((V, tags))
-    return out
 
 
 def entries(mat, row_coords, col_coords):

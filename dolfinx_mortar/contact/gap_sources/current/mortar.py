@@ -174,7 +174,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
                                   facet_search_factor=(FACET_SEARCH_FACTOR
                                                        if self.search_radius is None
                                                        else None),
-                                  keep_points=self.pointwise, self_contact=self.self_contact)
+                                  keep_points=self.pointwise, self_contact=self.self_contact,
+                                  whole_master=True)
         all_cells = slave.cells[coupling.pairs[:, 0]]
         # the values of every pair from the double kernel; derivatives only
         # where a node may carry contact force or stiffness

@@ -1,0 +1,147 @@
+"""Each rank's share of a distributed surface: the facets near where it searches
+(docs/DESIGN.md, §Parallel).
+
+A coupling needs, on each rank, the master facets that its slave facets may
+reach, not the whole master surface. Each rank describes where it searches by a
+few boxes (its slave facets' search boxes, grouped by recursive coordinate
+bisection and padded by a band), the boxes are shared (a few numbers per
+rank), and every rank sends each other rank only its own facets whose boxes
+meet that rank's. What a rank receives then grows with its share of the
+contact zone, not with the whole surface. The band (at least the largest
+facet) brings in every facet that shares a node with a facet the rank may
+pair: what the self-contact neighbour test and the interface normals need.
+
+MPI's own collectives do the exchange: DOLFINx offers no distributed search
+over a facet subset of another rank's boxes, and its bounding-box trees are
+built over whole meshes.
+"""
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+from dolfinx_mortar import _kernels
+from dolfinx_mortar.mortar.surface_normals import SurfaceCopy, gather_surface, volume_ids
+from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+
+FloatArray = npt.NDArray[np.float64]
+
+#: the most boxes by which a rank describes where it searches
+REGION_BOXES = 16
+
+
+def bisected_boxes(boxes: FloatArray, pieces: int = REGION_BOXES) -> FloatArray:
+    """At most ``pieces`` boxes covering ``boxes`` (n, 6: lower then upper
+    corner): the boxes' centres split in halves along their widest axis,
+    recursively, and each group's bounding box. Empty for no box."""
+    if len(boxes) == 0:
+        return np.zeros((0, 6))
+    groups = [np.arange(len(boxes))]
+    centres = 0.5 * (boxes[:, :3] + boxes[:, 3:])
+    while len(groups) < pieces:
+        sizes = [len(g) for g in groups]
+        widest = int(np.argmax(sizes))
+        group = groups[widest]
+        if len(group) < 2:
+            break
+        c = centres[group]
+        axis = int(np.argmax(np.ptp(c, axis=0)))
+        order = group[np.argsort(c[:, axis], kind="stable")]
+        half = len(order) // 2
+        groups[widest:widest + 1] = [order[:half], order[half:]]
+    return np.array([np.concatenate([boxes[g, :3].min(axis=0), boxes[g, 3:].max(axis=0)])
+                     for g in groups])
+
+
+def meeting(facet_boxes: FloatArray, region: FloatArray) -> npt.NDArray[np.bool_]:
+    """Which facet boxes meet any box of ``region`` (closed boxes)."""
+    if len(region) == 0 or len(facet_boxes) == 0:
+        return np.zeros(len(facet_boxes), dtype=bool)
+    lower = facet_boxes[:, None, :3] <= region[None, :, 3:]
+    upper = facet_boxes[:, None, 3:] >= region[None, :, :3]
+    return np.any(np.all(lower & upper, axis=2), axis=1)
+
+
+def largest_facet(surface: LagrangeSurface, x: FloatArray) -> float:
+    """The largest facet's extent (its largest coordinate range) over all ranks:
+    the band that brings every neighbour of a reachable facet along."""
+    cells = surface.cells
+    local = float(np.max(np.ptp(x[cells], axis=1), initial=0.0)) if len(cells) else 0.0
+    return surface.layout.comm.allreduce(local, op=MPI.MAX)
+
+
+def whole_surface(surface: LagrangeSurface, x: FloatArray) -> tuple[SurfaceCopy, int]:
+    """Every rank's facets on every rank (collective), and the bytes received
+    from the other ranks."""
+    copy = gather_surface(surface, x)
+    own = x[surface.cells].nbytes + surface.cells.size * copy.global_ids.itemsize
+    received = copy.x.nbytes + copy.global_ids.nbytes - own
+    if copy.volume_ids is not None:
+        received += copy.volume_ids.nbytes - surface.volume_nodes.size * copy.volume_ids.itemsize
+    return copy, int(received)
+
+
+class NearSurface:
+    """The facets of a distributed surface that a rank's search boxes may reach,
+    with what the exchange cost (collective).
+
+    Parameters
+    ----------
+    surface
+        The surface, each rank with its own cells.
+    x
+        Its local nodes' coordinates in the configuration of the search.
+    search_boxes
+        This rank's search boxes (n, 6): where its facets may find a partner.
+    band
+        How far beyond the boxes facets are still wanted (at least the
+        largest facet, so that the neighbours of every facet a box meets come
+        along).
+
+    Attributes
+    ----------
+    copy
+        The facets received (this rank's own included), as a
+        :class:`~dolfinx_mortar.mortar.surface_normals.SurfaceCopy`.
+    received_bytes
+        Bytes of coordinates and node ids received from other ranks.
+    """
+
+    def __init__(self, surface: LagrangeSurface, x: FloatArray, search_boxes: FloatArray,
+                 band: float):
+        comm: MPI.Comm = surface.layout.comm
+        if comm.size == 1:
+            self.copy, self.received_bytes = gather_surface(surface, x), 0
+            return
+        region = bisected_boxes(np.asarray(search_boxes, dtype=np.float64).reshape(-1, 6))
+        region[:, :3] -= band
+        region[:, 3:] += band
+        regions = comm.allgather(region)
+        cells = surface.cells
+        ids = surface.layout.global_indices[cells]
+        coords = x[cells]
+        volume = volume_ids(surface)
+        facet_boxes = (_kernels.facet_bounding_boxes(surface.facet_type, x,
+                                                     cells.astype(np.int32), 0.0)
+                       if len(cells) else np.zeros((0, 6)))
+        outgoing = []
+        for boxes in regions:
+            chosen = meeting(facet_boxes, boxes)
+            outgoing.append((ids[chosen], coords[chosen],
+                             None if volume is None else volume[chosen]))
+        incoming = comm.alltoall(outgoing)
+        self.received_bytes = int(sum(sum(a.nbytes for a in part if a is not None)
+                                      for rank, part in enumerate(incoming)
+                                      if rank != comm.rank))
+        nd = cells.shape[1]
+        global_ids = np.concatenate([part[0] for part in incoming]).reshape(-1, nd)
+        nc = len(global_ids)
+        xs = np.concatenate([part[1] for part in incoming]).reshape(nc * nd, x.shape[1])
+        received_volume = None
+        if volume is not None:
+            received_volume = np.concatenate([part[2] for part in incoming]).reshape(
+                nc, volume.shape[1])
+        self.copy = SurfaceCopy(surface.facet_type, xs,
+                                np.arange(nc * nd, dtype=np.int32).reshape(nc, nd),
+                                global_ids.ravel(), received_volume)

@@ -1,0 +1,74 @@
+"""Each rank's share of the master surface (:mod:`dolfinx_mortar.mortar.surface_exchange`):
+what a coupling finds with it is what it finds with the whole surface gathered, pair for
+pair, and the band brings every neighbour of a paired facet. Run on 1, 2 and 3 ranks."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from demo_support.self_mirror import CONTACT, build
+from dolfinx import fem
+from dolfinx_mortar.mortar.coupling import MortarCoupling
+from dolfinx_mortar.mortar.surface_exchange import bisected_boxes
+from dolfinx_mortar.surfaces.facet_surface import facet_surface
+from support.meshes import MASTER, SLAVE, two_blocks
+
+
+def test_bisected_boxes_cover_every_box_with_at_most_the_pieces_asked():
+    rng = np.random.default_rng(3)
+    lower = rng.random((500, 3))
+    boxes = np.hstack([lower, lower + 0.05 * rng.random((500, 3))])
+    for pieces in (1, 5, 16):
+        cover = bisected_boxes(boxes, pieces)
+        assert 1 <= len(cover) <= pieces
+        inside = np.all(boxes[:, None, :3] >= cover[None, :, :3], axis=2) & \
+            np.all(boxes[:, None, 3:] <= cover[None, :, 3:], axis=2)
+        assert np.all(inside.any(axis=1))
+    assert bisected_boxes(np.zeros((0, 6))).shape == (0, 6)
+
+
+def facet_keys(global_ids, cells):
+    """Each facet as the sorted tuple of its global node ids."""
+    return [tuple(sorted(ids)) for ids in global_ids[cells]]
+
+
+def two_block_surfaces():
+    (Vs, ts), (Vm, tm) = two_blocks(MPI.COMM_WORLD, 3, 1)
+    return facet_surface(Vs, ts, SLAVE), facet_surface(Vm, tm, MASTER), {}
+
+
+def c_body():
+    domain, tags = build(MPI.COMM_WORLD, 0.05, whole=True)
+    surface = facet_surface(fem.functionspace(domain, ("Lagrange", 1, (2,))), tags, CONTACT)
+    return surface, surface, {"self_contact": True, "search_radius": 0.2}
+
+
+@pytest.mark.parametrize("scene", [two_block_surfaces, c_body], ids=["3d-blocks", "self"])
+def test_a_rank_pairs_its_share_of_the_master_as_the_whole_master(scene):
+    """Two 3D blocks, and the C body's surface against itself: the pairs and
+    their integrals with the rank's share of the master are those with every
+    master facet gathered, every master facet that shares a node with a paired
+    one came along (the band), and what a rank receives is no more."""
+    slave, master, options = scene()
+    share = MortarCoupling(slave, master, interface_normals=True, **options)
+    whole = MortarCoupling(slave, master, interface_normals=True, whole_master=True, **options)
+    assert len(share.pairs) == len(whole.pairs)
+    keys = [facet_keys(c.master_global_ids, c.master_cells[c.pairs[:, 1]])
+            for c in (share, whole)]
+    order = [sorted(range(len(k)), key=lambda i, c=c, k=k: (c.pairs[i, 0], k[i]))
+             for c, k in zip((share, whole), keys)]
+    assert [keys[0][i] for i in order[0]] == [keys[1][i] for i in order[1]]
+    assert np.array_equal(share.pairs[order[0], 0], whole.pairs[order[1], 0])
+    for a, b in zip(share.raw_pairs, whole.raw_pairs):
+        scale = max(np.max(np.abs(b), initial=0.0), 1e-300)
+        assert np.allclose(a[order[0]], b[order[1]], rtol=0, atol=1e-13 * scale)
+    # the band: every neighbour of a paired master facet is in the share
+    received = set(facet_keys(share.master_global_ids, share.master_cells))
+    paired = {key for key in keys[0]}
+    for key in facet_keys(whole.master_global_ids, whole.master_cells):
+        if any(set(key) & set(p) for p in paired):
+            assert key in received
+    assert share.received_bytes <= whole.received_bytes
+    if MPI.COMM_WORLD.size == 1:
+        assert share.received_bytes == whole.received_bytes == 0
