@@ -32,11 +32,13 @@ from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, pars
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
 from dolfinx_mortar.mortar.facet_search import candidate_pairs, near_in_surface, search_boxes
-from dolfinx_mortar.mortar.surface_exchange import NearSurface, largest_facet, whole_surface
-# the surfaces' geometry lives in surface_normals; these names stay importable here
+# the surfaces' copies live in surface_exchange, their geometry in surface_normals;
+# these names stay importable here
+from dolfinx_mortar.mortar.surface_exchange import (  # noqa: F401
+    NearSurface, SurfaceCopy, gather_surface, largest_facet, whole_surface)
 from dolfinx_mortar.mortar.surface_normals import (  # noqa: F401
-    SurfaceCopy, averaged_nodal_normals, cluster_diameters, current_coordinates,
-    gather_surface, interface_nodal_normals, normal_clusters, swept_facet_boxes)
+    averaged_nodal_normals, cluster_diameters, clusters_and_bytes, current_coordinates,
+    interface_nodal_normals, normal_clusters, swept_facet_boxes)
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
 FloatArray = npt.NDArray[np.float64]
@@ -153,21 +155,23 @@ class MortarCoupling:
         comm = slave.layout.comm
         xs = current_coordinates(slave, slave_displacement)
         xm = current_coordinates(master, master_displacement)
-        clusters = normal_clusters(slave, xs)
+        clusters, slave_bytes = clusters_and_bytes(slave, xs)
         self.normals = averaged_nodal_normals(slave, xs, clusters)
         slave_cells = slave.cells.astype(np.int32)
         self.search_radius, slave_boxes = search_boxes(
             slave, xs, slave_cells, clusters, search_radius, facet_search_factor)
         if whole_master:
-            master_copy, self.received_bytes = whole_surface(master, xm)
+            master_copy, master_bytes = whole_surface(master, xm)
         else:
             near = NearSurface(master, xm, slave_boxes, largest_facet(master, xm))
-            master_copy, self.received_bytes = near.copy, near.received_bytes
+            master_copy, master_bytes = near.copy, near.received_bytes
+        self.received_bytes = slave_bytes + master_bytes
         self.timings["normals_and_gather"] = time.perf_counter() - clock
         clock = time.perf_counter()
         #: the master facets this rank's slave facets may reach, with a band
-        #: (all ranks' with ``whole_master``), one node copy per cell; and the
-        #: bytes this rank received for them from the other ranks
+        #: (all ranks' with ``whole_master``), one node copy per cell;
+        #: ``received_bytes``: what this rank received from the other ranks for
+        #: them and for the slave's normal clusters
         self.master_copy = master_copy
         self.master_global_ids = master_copy.global_ids
         self.master_cells = master_copy.cells
@@ -239,12 +243,16 @@ class MortarCoupling:
         lines = [f"slave facet {c} (local cell index on rank {comm.rank}) with nodes "
                  f"{np.array2string(xs[slave_cells[c]], precision=17, separator=', ')}"
                  for c in r.degenerate_slave_facets[:5]]
-        lines += [f"master facet with nodes "
-                  f"{np.array2string(master_copy.x[master_copy.cells[c]], precision=17, separator=', ')}"
-                  for c in r.degenerate_master_facets[:5]]
-        # a master facet near several ranks' slave facets is named once
-        lines = list(dict.fromkeys(line for rank_lines in comm.allgather(lines)
-                                   for line in rank_lines))
+        lines = [line for rank_lines in comm.allgather(lines) for line in rank_lines]
+        # a master facet near several ranks' slave facets is named once (by its nodes)
+        master_lines: dict[str, str] = {}
+        for rank_lines in comm.allgather(
+                [(np.array2string(master_copy.x[master_copy.cells[c]], precision=17,
+                                  separator=', '), c) for c in r.degenerate_master_facets[:5]]):
+            for nodes, c in rank_lines:
+                master_lines.setdefault(nodes, f"master facet {c} (index in the received "
+                                               f"master facets) with nodes {nodes}")
+        lines += list(master_lines.values())
         if lines:
             raise DegenerateGeometryError(
                 f"degenerate contact facets (length or height at most the zero length "

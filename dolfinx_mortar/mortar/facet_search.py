@@ -9,8 +9,8 @@ import numpy.typing as npt
 from mpi4py import MPI
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.mortar.surface_normals import (SurfaceCopy, cluster_diameters,
-                                                   swept_facet_boxes, volume_ids)
+from dolfinx_mortar.mortar.surface_exchange import SurfaceCopy, volume_ids
+from dolfinx_mortar.mortar.surface_normals import cluster_diameters, swept_facet_boxes
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
 FloatArray = npt.NDArray[np.float64]

@@ -17,18 +17,77 @@ built over whole meshes.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Optional
+
 import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.mortar.surface_normals import SurfaceCopy, gather_surface, volume_ids
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
 FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
 
 #: the most boxes by which a rank describes where it searches
 REGION_BOXES = 16
+
+
+@dataclass
+class SurfaceCopy:
+    """What segmentation needs of a (possibly gathered) surface.
+
+    Attributes
+    ----------
+    facet_type
+        The kernels' facet type.
+    x
+        Node coordinates in the configuration of interest, (nodes, gdim).
+    cells
+        Node indices of each cell, (cells, nodes per cell).
+    global_ids
+        Global function index of each node in the surface's layout.
+    volume_ids
+        Per cell, the global indices (in the surface's layout) of the nodes of
+        the volume cell it bounds, where the surface knows them
+        (``LagrangeSurface.volume_nodes``); else None.
+    """
+
+    facet_type: _kernels.FacetType
+    x: FloatArray
+    cells: npt.NDArray[np.int32]
+    global_ids: IntArray
+    volume_ids: Optional[IntArray] = None
+
+
+def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
+    """All ranks' cells of a surface, with one copy of the nodes per cell.
+
+    What the current configuration's shared-out Jet work needs: both surfaces,
+    the same on every rank. A frozen coupling receives only the master facets
+    near its slave facets (:class:`~dolfinx_mortar.mortar.surface_exchange.NearSurface`).
+    """
+    comm = surface.layout.comm
+    global_ids = surface.layout.global_indices[surface.cells]
+    coords = x[surface.cells]
+    volume = volume_ids(surface)
+    if comm.size > 1:
+        global_ids = np.concatenate(comm.allgather(global_ids)).reshape(-1, surface.cells.shape[1])
+        coords = np.concatenate(comm.allgather(coords)).reshape(-1, *coords.shape[1:])
+        if volume is not None:
+            volume = np.concatenate(comm.allgather(volume)).reshape(-1, volume.shape[1])
+    nc, nd = global_ids.shape
+    return SurfaceCopy(surface.facet_type, coords.reshape(nc * nd, -1),
+                       np.arange(nc * nd, dtype=np.int32).reshape(nc, nd),
+                       global_ids.ravel(), volume)
+
+
+def volume_ids(surface: LagrangeSurface) -> Optional[IntArray]:
+    """The global indices of each local cell's volume cell nodes (None where unknown)."""
+    if surface.volume_nodes is None:
+        return None
+    return surface.layout.global_indices[surface.volume_nodes]
 
 
 def bisected_boxes(boxes: FloatArray, pieces: int = REGION_BOXES) -> FloatArray:

@@ -3,45 +3,18 @@ copies, averaged and interface nodal normals, the clusters of nodes that share
 a normal, and the facets' swept search boxes (docs/DESIGN.md, §Segmentation)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
 import numpy.typing as npt
 
 from dolfinx_mortar import _kernels
+from dolfinx_mortar.mortar.surface_exchange import NearSurface, SurfaceCopy, largest_facet
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.tolerance import GEOMETRIC_TOLERANCE
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
-
-
-@dataclass
-class SurfaceCopy:
-    """What segmentation needs of a (possibly gathered) surface.
-
-    Attributes
-    ----------
-    facet_type
-        The kernels' facet type.
-    x
-        Node coordinates in the configuration of interest, (nodes, gdim).
-    cells
-        Node indices of each cell, (cells, nodes per cell).
-    global_ids
-        Global function index of each node in the surface's layout.
-    volume_ids
-        Per cell, the global indices (in the surface's layout) of the nodes of
-        the volume cell it bounds, where the surface knows them
-        (``LagrangeSurface.volume_nodes``); else None.
-    """
-
-    facet_type: _kernels.FacetType
-    x: FloatArray
-    cells: npt.NDArray[np.int32]
-    global_ids: IntArray
-    volume_ids: Optional[IntArray] = None
 
 
 def current_coordinates(surface: LagrangeSurface,
@@ -94,14 +67,30 @@ def normal_clusters(surface: LagrangeSurface, x: FloatArray) -> dict[int, int]:
     Two nodes of a cell closer than ``NEGLIGIBLE_FACET_RATIO`` times the
     largest cell around them (dolfinx_mortar/tolerance.py) are one cluster:
     the facet between them is a meshing artifact, not a feature. Decided by
-    the kernel on the gathered surface (collective), so the same on every
+    the kernel on the cells near this rank's (collective), so the same on every
     rank and the same as the current configuration's exact derivatives.
     """
-    copy = gather_surface(surface, x)
+    return clusters_and_bytes(surface, x)[0]
+
+
+def clusters_and_bytes(surface: LagrangeSurface, x: FloatArray) -> tuple[dict[int, int], int]:
+    """:func:`normal_clusters`, and the bytes this rank received for them."""
+    # the cells around this rank's nodes and a band beyond: a cluster is a few
+    # facets a thousandth of their neighbours long, well inside the band
+    own = (_kernels.facet_bounding_boxes(surface.facet_type, x, surface.cells.astype(np.int32),
+                                         0.0) if len(surface.cells) else np.zeros((0, 6)))
+    near = NearSurface(surface, x, own, 2.0 * largest_facet(surface, x))
+    copy = near.copy
     ids = copy.global_ids.astype(np.int64)
     roots = _kernels.normal_clusters(surface.facet_type, copy.x, copy.cells, ids)
     members = np.isin(roots, roots[roots != ids])
-    return dict(zip(ids[members].tolist(), roots[members].tolist()))
+    local = dict(zip(ids[members].tolist(), roots[members].tolist()))
+    # the union over the ranks (clusters are rare): the same dict on every rank,
+    # so that every rank takes the same collective branches on it
+    clusters: dict[int, int] = {}
+    for part in surface.layout.comm.allgather(local):
+        clusters.update(part)
+    return clusters, near.received_bytes
 
 
 def cluster_diameters(surface: LagrangeSurface, clusters: dict[int, int],
@@ -255,32 +244,3 @@ def swept_facet_boxes(surface: LagrangeSurface, x: FloatArray, cells: npt.NDArra
     boxes[:, :3] = np.maximum(boxes[:, :3] - margin, facet[:, :3] - reach)
     boxes[:, 3:] = np.minimum(boxes[:, 3:] + margin, facet[:, 3:] + reach)
     return boxes
-
-
-def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
-    """All ranks' cells of a surface, with one copy of the nodes per cell.
-
-    What the current configuration's shared-out Jet work needs: both surfaces,
-    the same on every rank. A frozen coupling receives only the master facets
-    near its slave facets (:class:`~dolfinx_mortar.mortar.surface_exchange.NearSurface`).
-    """
-    comm = surface.layout.comm
-    global_ids = surface.layout.global_indices[surface.cells]
-    coords = x[surface.cells]
-    volume = volume_ids(surface)
-    if comm.size > 1:
-        global_ids = np.concatenate(comm.allgather(global_ids)).reshape(-1, surface.cells.shape[1])
-        coords = np.concatenate(comm.allgather(coords)).reshape(-1, *coords.shape[1:])
-        if volume is not None:
-            volume = np.concatenate(comm.allgather(volume)).reshape(-1, volume.shape[1])
-    nc, nd = global_ids.shape
-    return SurfaceCopy(surface.facet_type, coords.reshape(nc * nd, -1),
-                       np.arange(nc * nd, dtype=np.int32).reshape(nc, nd),
-                       global_ids.ravel(), volume)
-
-
-def volume_ids(surface: LagrangeSurface) -> Optional[IntArray]:
-    """The global indices of each local cell's volume cell nodes (None where unknown)."""
-    if surface.volume_nodes is None:
-        return None
-    return surface.layout.global_indices[surface.volume_nodes]
