@@ -54,17 +54,17 @@ DEV_ROOT ?= dev
 .NOTPARALLEL:
 
 .PHONY: help setup deps venv build-cpp demo test test-cpp test-python test-mpi test-coretype \
-	test-paraview \
+	test-paraview test-ranks \
 	bench bench-speed bench-scale stress shell-trixie shell-sid clean
 
 help:
 	@echo "make setup  - install missing Debian packages, make the virtual environment .venv (it sees"
 	@echo "              Debian's DOLFINx) and install dolfinx_mortar into it: pip builds the kernels"
 	@echo "make demo   - setup, then the main demo (Hertz 2D, figures 1 and 2) into results/"
-	@echo "make test   - setup, then C++ tests (ctest), pytest, pytest under mpirun -n 2, and"
-	@echo "              pytest again with another CPU's BLAS kernels (OPENBLAS_CORETYPE)"
+	@echo "make test   - setup, then C++ tests (ctest), pytest, pytest under mpirun -n 2, a few"
+	@echo "              tests on 3 and 4 ranks, and pytest again with another CPU's BLAS kernels"
 	@echo "make test-cpp    - build the C++ kernels and their GoogleTest tests in build/, run ctest"
-	@echo "make test-python / test-mpi / test-coretype - one of the pytest runs of make test"
+	@echo "make test-python / test-mpi / test-ranks / test-coretype - one of the pytest runs of make test"
 	@echo "make test-paraview - ParaView (pvpython, installed if missing) opens a series the library"
 	@echo "              writes and reads its last step as written (tools/paraview_check.py)"
 	@echo "make bench  - setup, then the benchmarks in benchmarks/ (speed vs error: --quick)"
@@ -119,7 +119,7 @@ demo: setup
 	$(PYTHON) demos/fig1_bases.py --json results/fig1_bases.json
 	$(PYTHON) demos/fig2_sphere_nurbs.py --json results/fig2_pressures.json
 
-test: setup test-cpp test-python test-mpi test-coretype test-paraview
+test: setup test-cpp test-python test-mpi test-ranks test-coretype test-paraview
 
 test-cpp: build-cpp
 	cd $(BUILD_DIR) && ctest --output-on-failure
@@ -129,6 +129,17 @@ test-python:
 
 test-mpi:
 	$(MPIRUN) $(PYTEST) -p no:cacheprovider tests
+
+# More ranks than cores (oversubscribed: correct, not fast; OMPI yields while it waits): the
+# surface exchange's invariants on 3 ranks, and the mirror, patch and friction tests on 4.
+RANKS_TESTS_3 = tests/mortar/test_surface_exchange.py tests/mortar/test_mortar_parallel.py \
+	tests/contact/test_self_contact_friction.py tests/contact/test_many_bodies.py
+RANKS_TESTS_4 = tests/contact/test_mirror.py tests/solver/test_problem.py::test_patch_test_passes_with_the_consistent_scaling \
+	tests/solver/test_two_meshes.py::test_patch_test_on_two_meshes_matches_one_mesh \
+	tests/contact/test_friction_scenes.py tests/contact/test_self_contact_friction.py
+test-ranks:
+	OMPI_MCA_mpi_yield_when_idle=1 timeout 1200 mpirun -n 3 --oversubscribe $(PYTEST) -p no:cacheprovider $(RANKS_TESTS_3)
+	OMPI_MCA_mpi_yield_when_idle=1 timeout 1200 mpirun -n 4 --oversubscribe $(PYTEST) -p no:cacheprovider $(RANKS_TESTS_4)
 
 test-coretype:
 	@coretype=$(or $(SECOND_CORETYPE),$$($(PYTHON) tools/second_coretype.py)) && \

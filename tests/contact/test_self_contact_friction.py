@@ -12,6 +12,7 @@ from dolfinx import fem
 
 from dolfinx_mortar import ContactProblem, CoulombFriction
 from dolfinx_mortar.meshes.merge_meshes import merge_bodies
+from demo_support.self_mirror import BOTTOM as C_BOTTOM, CONTACT, SLAB, SYMMETRY_X, TOP as C_TOP, build
 from support import load_demo
 from support.meshes import rectangle
 
@@ -108,3 +109,36 @@ def test_friction_in_self_contact_in_3d_keeps_the_patch_test():
     assert np.allclose(pressure.p, Q, rtol=1e-8, atol=0)
     assert np.allclose(friction.q, 0.0, rtol=0, atol=1e-8 * Q)
     assert np.all(friction.stick_slip == 1)
+
+
+@pytest.mark.parametrize("shape", [{"axisymmetric": True}, {"thickness": 0.1}],
+                         ids=["axisymmetric", "3d-slab"])
+def test_arms_that_press_without_sliding_on_each_other_carry_no_friction(shape):
+    """The C body squeezed until its arms press on each other, as a body of
+    revolution and as a 3D slab: by its symmetry the arms hardly slide on each
+    other (the bases pair points along the undeformed arcs' normals, so the
+    measured slip is not exactly 0), so with friction every node in contact
+    sticks with a tangential traction below 1e-4 of the peak pressure
+    (measured 5e-5 and 1.7e-6), and the pressures stay within 2e-3 of the
+    frictionless ones (1.1e-3 and 5.3e-5)."""
+    comm, h, d = MPI.COMM_WORLD, 0.1, 0.02
+    thickness = shape.get("thickness", 0.0)
+    dim = 3 if thickness else 2
+    body, tags = build(comm, h, whole=True, thickness=thickness)
+    V = fem.functionspace(body, ("Lagrange", 1, (dim,)))
+    slab = {SLAB: {2: 0.0}} if thickness else {}
+    runs = []
+    for friction in (None, CoulombFriction(MU)):
+        problem = ContactProblem(V, tags, CONTACT, self_contact=True, penalty=1e4, E=1.0,
+                                 nu=0.3, kind="LcLS*", friction=friction,
+                                 axisymmetric=shape.get("axisymmetric", False),
+                                 fixed={C_TOP: {1: -d}, C_BOTTOM: {1: d}, SYMMETRY_X: {0: 0.0},
+                                        **slab})
+        problem.solve(load_steps=2)
+        runs.append(problem)
+    plain, rubbing = (p.surface_pressure(gather=True) for p in runs)
+    assert plain.p.max() > 0
+    assert np.allclose(rubbing.p, plain.p, rtol=0, atol=2e-3 * plain.p.max())
+    friction = runs[1].contact.results.surface_friction(gather=True)
+    assert np.allclose(friction.q, 0.0, rtol=0, atol=1e-4 * plain.p.max())
+    assert np.all(friction.stick_slip[plain.p > 0] == 1)
