@@ -161,9 +161,10 @@ class MortarCoupling:
         self.search_radius, slave_boxes = search_boxes(
             slave, xs, slave_cells, clusters, search_radius, facet_search_factor)
         if whole_master:
-            master_copy, master_bytes = whole_surface(master, xm)
+            master_copy, master_bytes = whole_surface(master, xm, with_volume=self_contact)
         else:
-            near = NearSurface(master, xm, slave_boxes, largest_facet(master, xm))
+            near = NearSurface(master, xm, slave_boxes, largest_facet(master, xm),
+                               with_volume=self_contact)
             master_copy, master_bytes = near.copy, near.received_bytes
         self.received_bytes = slave_bytes + master_bytes
         self.timings["normals_and_gather"] = time.perf_counter() - clock

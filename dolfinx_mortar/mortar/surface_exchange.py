@@ -50,8 +50,8 @@ class SurfaceCopy:
         Global function index of each node in the surface's layout.
     volume_ids
         Per cell, the global indices (in the surface's layout) of the nodes of
-        the volume cell it bounds, where the surface knows them
-        (``LagrangeSurface.volume_nodes``); else None.
+        the volume cell it bounds, where asked for (self-contact) and the
+        surface knows them (``LagrangeSurface.volume_nodes``); else None.
     """
 
     facet_type: _kernels.FacetType
@@ -61,7 +61,8 @@ class SurfaceCopy:
     volume_ids: Optional[IntArray] = None
 
 
-def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
+def gather_surface(surface: LagrangeSurface, x: FloatArray,
+                   with_volume: bool = False) -> SurfaceCopy:
     """All ranks' cells of a surface, with one copy of the nodes per cell.
 
     What the current configuration's shared-out Jet work needs: both surfaces,
@@ -71,7 +72,7 @@ def gather_surface(surface: LagrangeSurface, x: FloatArray) -> SurfaceCopy:
     comm = surface.layout.comm
     global_ids = surface.layout.global_indices[surface.cells]
     coords = x[surface.cells]
-    volume = volume_ids(surface)
+    volume = volume_ids(surface) if with_volume else None
     if comm.size > 1:
         global_ids = np.concatenate(comm.allgather(global_ids)).reshape(-1, surface.cells.shape[1])
         coords = np.concatenate(comm.allgather(coords)).reshape(-1, *coords.shape[1:])
@@ -130,10 +131,11 @@ def largest_facet(surface: LagrangeSurface, x: FloatArray) -> float:
     return surface.layout.comm.allreduce(local, op=MPI.MAX)
 
 
-def whole_surface(surface: LagrangeSurface, x: FloatArray) -> tuple[SurfaceCopy, int]:
+def whole_surface(surface: LagrangeSurface, x: FloatArray,
+                  with_volume: bool = False) -> tuple[SurfaceCopy, int]:
     """Every rank's facets on every rank (collective), and the bytes received
     from the other ranks."""
-    copy = gather_surface(surface, x)
+    copy = gather_surface(surface, x, with_volume)
     own = x[surface.cells].nbytes + surface.cells.size * copy.global_ids.itemsize
     received = copy.x.nbytes + copy.global_ids.nbytes - own
     if copy.volume_ids is not None:
@@ -157,6 +159,9 @@ class NearSurface:
         How far beyond the boxes facets are still wanted (at least the
         largest facet, so that the neighbours of every facet a box meets come
         along).
+    with_volume
+        Also send each facet's volume cell nodes (what the self-contact
+        neighbour test needs), where the surface knows them.
 
     Attributes
     ----------
@@ -168,10 +173,10 @@ class NearSurface:
     """
 
     def __init__(self, surface: LagrangeSurface, x: FloatArray, search_boxes: FloatArray,
-                 band: float):
+                 band: float, with_volume: bool = False):
         comm: MPI.Comm = surface.layout.comm
         if comm.size == 1:
-            self.copy, self.received_bytes = gather_surface(surface, x), 0
+            self.copy, self.received_bytes = gather_surface(surface, x, with_volume), 0
             return
         region = bisected_boxes(np.asarray(search_boxes, dtype=np.float64).reshape(-1, 6))
         region[:, :3] -= band
@@ -180,7 +185,7 @@ class NearSurface:
         cells = surface.cells
         ids = surface.layout.global_indices[cells]
         coords = x[cells]
-        volume = volume_ids(surface)
+        volume = volume_ids(surface) if with_volume else None
         facet_boxes = (_kernels.facet_bounding_boxes(surface.facet_type, x,
                                                      cells.astype(np.int32), 0.0)
                        if len(cells) else np.zeros((0, 6)))
