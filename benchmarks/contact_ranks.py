@@ -103,7 +103,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--h", type=float, default=1.0, help="ironing3d --h (1)")
     parser.add_argument("--press-steps", type=int, default=3, help="ironing3d (3)")
     parser.add_argument("--slide-steps", type=int, default=4, help="ironing3d (4)")
-    parser.add_argument("--penalty", type=float, default=1e3, help="ε as a multiple of E/h")
+    parser.add_argument("--penalty", type=float, default=1e3,
+                        help="hertz3d: ε as a multiple of E/h (1e3)")
     parser.add_argument("--partitioner", default="graph", choices=("graph", "contact"))
     parser.add_argument("--summarize", action="store_true",
                         help="only rewrite the summary from the per-rank files in --out")
