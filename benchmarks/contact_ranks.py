@@ -5,8 +5,8 @@ elastic``: LcLS*, nodal active set, 3 load steps, the iterative solver) and
 reports, for every rank, the CPU time of its contact phases (setup: normals
 and gather, search, segmentation, the rest; residual evaluations; Jacobians)
 next to its bulk assembly, what it holds of the contact (owned slave nodes,
-slave facets, master facets in its gathered master copy, candidate and
-segmented pairs) and the bytes it received in the surface gathers. Ranks may
+slave facets, master facets in its master copy, candidate and segmented
+pairs) and the bytes it received from other ranks for the surfaces. Ranks may
 outnumber the cores (``--oversubscribe``), so times are process CPU time,
 not wall time. ``--scene ironing3d`` runs a small sliding scene instead
 (``demos/ironing3d.py``: a die pressed into a slab and slid along it, on the
@@ -36,17 +36,22 @@ replaces the name ``time`` in those three modules (``mortar/coupling.py``,
 ``perf_counter`` is ``time.process_time``: the library's own timing code then
 adds up each rank's CPU time, phase by phase, and nothing in the library
 changes. The Hertz rows are :func:`contact_parallel.rank_row`'s. The
-``MortarCoupling`` constructor is wrapped where the gap sources look it up, to
-sum the phases of every coupling made and keep the last one.
+``MortarCoupling`` constructor is wrapped, to sum the phases and bytes of every
+coupling made and keep the last one.
 
-How the bytes are counted: ``gather_surface`` (mortar/surface_normals.py)
-allgathers every rank's cells of a surface, the master's for the coupling and
-the slave's for its normal clusters. The script wraps it where the library
-looks it up and adds, per call, the bytes of the gathered node coordinates and
-global ids that came from other ranks (all cells but the rank's own).
-``master_bytes`` is the master copy's part alone, computed afterwards from
-``coupling.master_copy``. Pickling adds about 150 bytes per array and
-rank, not counted.
+How the bytes are counted: every ``MortarCoupling`` reports
+``received_bytes``, what its rank received from the other ranks for it (its
+share of the master surface, ``NearSurface``, or the whole master with
+``whole_master``; and the slave facets near its own for the normal
+clusters). The script wraps ``MortarCoupling.__init__`` during the run and
+adds them up over every coupling made (``coupling_bytes``). The current
+configuration also gathers the whole slave surface outside any coupling
+(``gathered_pair_derivatives``): the script wraps ``gather_surface`` in
+``contact/gap_sources/current/mortar.py`` only and adds, per call, the bytes
+of the gathered node coordinates, global ids and volume cell ids that came from
+other ranks (all cells but the rank's own; ``gathers`` counts these calls).
+``bytes_received`` is the sum of both. Pickling adds about 150 bytes per array
+and rank, not counted.
 
 Waiting costs CPU time too: a rank waiting in a collective polls. Run with
 ``OMPI_MCA_mpi_yield_when_idle=1``: a test rank waiting 2 s for another was
@@ -74,18 +79,16 @@ from contact_parallel import rank_row
 from dolfinx_mortar.io.output import write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent
-#: the modules whose phase timings are read, and those that look ``gather_surface`` up
+#: the modules whose phase timings are read, and the one whose ``gather_surface``
+#: calls are outside any coupling
 CLOCKED = ("dolfinx_mortar.mortar.coupling", "dolfinx_mortar.contact.term",
            "dolfinx_mortar.solver.nonlinear_problem")
-GATHERING = ("dolfinx_mortar.mortar.surface_normals", "dolfinx_mortar.mortar.coupling",
-             "dolfinx_mortar.contact.gap_sources.current.mortar")
-MAKING = ("dolfinx_mortar.contact.gap_sources.choice",
-          "dolfinx_mortar.contact.gap_sources.current.mortar")
+GATHERING = ("dolfinx_mortar.contact.gap_sources.current.mortar",)
 RANK_COLUMNS = ("rank", "dofs", "newton", "krylov", "owned_slave_nodes", "slave_facets",
                 "master_facets", "candidates", "pairs", "normals_and_gather", "search",
                 "segmentation", "setup_rest", "setup", "residual", "jacobian",
                 "contact_total", "bulk", "cpu", "wall", "gathers", "bytes_received",
-                "master_bytes", "couplings")
+                "coupling_bytes", "couplings")
 TIMES = ("normals_and_gather", "search", "segmentation", "setup_rest", "setup", "residual",
          "jacobian", "contact_total", "bulk", "cpu", "wall")
 HOLDINGS = ("owned_slave_nodes", "slave_facets", "master_facets", "candidates", "pairs")
@@ -124,10 +127,11 @@ class _ProcessClock(types.ModuleType):
 
 
 @contextmanager
-def replaced(modules: Sequence[str], name: str, make: Callable) -> Iterator[None]:
-    """Each module's attribute ``name`` is ``make(old value)`` inside the block."""
-    saved = [(importlib.import_module(m), getattr(importlib.import_module(m), name))
-             for m in modules]
+def replaced(owners: Sequence, name: str, make: Callable) -> Iterator[None]:
+    """Each owner's attribute ``name`` is ``make(old value)`` inside the block
+    (an owner is a module, by name, or any object such as a class)."""
+    objects = [importlib.import_module(m) if isinstance(m, str) else m for m in owners]
+    saved = [(o, getattr(o, name)) for o in objects]
     try:
         for module, old in saved:
             setattr(module, name, make(old))
@@ -139,15 +143,18 @@ def replaced(modules: Sequence[str], name: str, make: Callable) -> Iterator[None
 
 def received_bytes(copy, own_cells: int) -> int:
     """Bytes of a gathered surface copy (``SurfaceCopy``) that came from other
-    ranks: coordinates and global ids of every cell but the rank's own."""
+    ranks: coordinates, global ids and volume cell ids (where gathered) of
+    every cell but the rank's own."""
     cells = len(copy.cells)
     if cells == 0:
         return 0
-    return (cells - own_cells) * ((copy.x.nbytes + copy.global_ids.nbytes) // cells)
+    volume = 0 if copy.volume_ids is None else copy.volume_ids.nbytes
+    return (cells - own_cells) * ((copy.x.nbytes + copy.global_ids.nbytes + volume) // cells)
 
 
 class GatherCount:
-    """Calls of ``gather_surface`` on this rank and the bytes they received."""
+    """Calls of ``gather_surface`` outside any coupling on this rank and the
+    bytes they received."""
 
     def __init__(self) -> None:
         self.calls, self.bytes = 0, 0
@@ -163,31 +170,33 @@ class GatherCount:
 
 
 class CouplingLog:
-    """Every ``MortarCoupling`` made on this rank: the last one, and the CPU
-    time of each phase summed over all (the current configuration makes one
-    per residual evaluation)."""
+    """Every ``MortarCoupling`` made on this rank: the last one, the CPU time of
+    each phase and the bytes received, summed over all (the current
+    configuration makes one per residual evaluation)."""
 
     def __init__(self) -> None:
-        self.last, self.made, self.timings = None, 0, {}
+        self.last, self.made, self.timings, self.bytes = None, 0, {}, 0
 
-    def wrap(self, cls: type) -> Callable:
-        def made(*args, **kwargs):
-            coupling = cls(*args, **kwargs)
+    def wrap(self, init: Callable) -> Callable:
+        @functools.wraps(init)
+        def made(coupling, *args, **kwargs):
+            init(coupling, *args, **kwargs)
             self.last, self.made = coupling, self.made + 1
+            self.bytes += coupling.received_bytes
             for key, value in coupling.timings.items():
                 self.timings[key] = self.timings.get(key, 0.0) + value
-            return coupling
         return made
 
 
 @contextmanager
 def measured(count: GatherCount, couplings: CouplingLog) -> Iterator[None]:
-    """The library's phase clocks on process time, its gathers counted and its
-    couplings logged, inside the block."""
+    """The library's phase clocks on process time, its gathers outside the
+    couplings counted and its couplings logged, inside the block."""
+    from dolfinx_mortar.mortar.coupling import MortarCoupling
     with ExitStack() as stack:
         stack.enter_context(replaced(CLOCKED, "time", lambda _: _ProcessClock()))
         stack.enter_context(replaced(GATHERING, "gather_surface", count.wrap))
-        stack.enter_context(replaced(MAKING, "MortarCoupling", couplings.wrap))
+        stack.enter_context(replaced([MortarCoupling], "__init__", couplings.wrap))
         yield
 
 
@@ -209,8 +218,8 @@ def hertz3d(args: argparse.Namespace, comm) -> dict:
     coupling = problem.contact.source.coupling
     row.update(master_facets=len(coupling.master_copy.cells),
                setup=problem.timings.get("contact_setup", 0.0), cpu=cpu,
-               gathers=count.calls, bytes_received=count.bytes, couplings=couplings.made,
-               master_bytes=received_bytes(coupling.master_copy, len(problem.master.cells)))
+               gathers=count.calls, bytes_received=count.bytes + couplings.bytes,
+               couplings=couplings.made, coupling_bytes=couplings.bytes)
     return row
 
 
@@ -251,9 +260,9 @@ def ironing3d(args: argparse.Namespace, comm) -> dict:
            "residual": t.get("contact_residual", 0.0),
            "jacobian": t.get("contact_jacobian", 0.0),
            "bulk": t.get("bulk_residual", 0.0) + t.get("bulk_jacobian", 0.0),
-           "cpu": cpu, "wall": wall, "gathers": count.calls, "bytes_received": count.bytes,
-           "couplings": couplings.made,
-           "master_bytes": received_bytes(last.master_copy, len(term.master.cells))}
+           "cpu": cpu, "wall": wall, "gathers": count.calls,
+           "bytes_received": count.bytes + couplings.bytes, "couplings": couplings.made,
+           "coupling_bytes": couplings.bytes}
     row.update({k: couplings.timings.get(k, 0.0)
                 for k in ("normals_and_gather", "search", "segmentation")})
     row["contact_total"] = sum(v for k, v in t.items() if k.startswith("contact_"))
@@ -287,8 +296,8 @@ def summary(rows: list[dict]) -> dict:
 def markdown(stem: str, per_count: dict[int, list[dict]]) -> str:
     """The summary table and each rank count's per-rank table."""
     rows = [summary(per_count[p]) for p in sorted(per_count)]
-    lines = [f"# {stem}", "", "CPU times (process clock) in s, bytes received in the surface "
-             "gathers in kB; the busiest rank is the one with the most segmented pairs.", "",
+    lines = [f"# {stem}", "", "CPU times (process clock) in s, bytes received from other ranks "
+             "for the surfaces in kB; the busiest rank is the one with the most segmented pairs.", "",
              "| ranks | dofs | Newton | contact CPU max | mean | busiest rank: contact CPU | "
              "owned slave nodes | slave facets | master copy facets | candidates | pairs | "
              "kB received max | mean | bulk CPU max | mean | CPU max | contact share | wall s |",
