@@ -26,11 +26,11 @@ import numpy.typing as npt
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
+from dolfinx_mortar.mortar.degenerate_facets import raise_on_degenerate_facets
 from dolfinx_mortar.mortar.facet_search import candidate_pairs, near_in_surface, search_boxes
 # the surfaces' copies live in surface_exchange, their geometry in surface_normals;
 # these names stay importable here
@@ -205,11 +205,13 @@ class MortarCoupling:
         r = segment(self.normals, keep_points and not interface_normals, False)
         if interface_normals:
             # pairing and gap along the interface normals, not the facets' own
-            self._raise_on_degenerate_facets(r, xs, slave_cells, master_copy)
+            raise_on_degenerate_facets(r, xs, slave_cells, master_copy, comm,
+                                       self.zero_length, self.length_scale)
             self.normals = interface_nodal_normals(slave, self.normals, master_copy,
                                                    r.pairs, r.area, clusters)
             r = segment(self.normals, keep_points, True)
-        self._raise_on_degenerate_facets(r, xs, slave_cells, master_copy)
+        raise_on_degenerate_facets(r, xs, slave_cells, master_copy, comm, self.zero_length,
+                                   self.length_scale)
         self.timings["segmentation"] = time.perf_counter() - clock
         self.num_candidates = len(candidates)
         self.failed_projections = comm.allreduce(int(r.failed_projections))
@@ -234,31 +236,6 @@ class MortarCoupling:
                                         minlength=len(slave.cells))
         self._bases: dict[BasisKind, MortarBasis] = {}
         self._covered_mass: Optional[tuple] = None
-
-    def _raise_on_degenerate_facets(self, r: _kernels.MortarIntegrals, xs: FloatArray,
-                                    slave_cells,
-                                    master_copy: SurfaceCopy) -> None:
-        """A degenerate facet covers nothing: rather than let it vanish from the
-        integrals, stop on every rank with the facets named."""
-        comm = self.slave.layout.comm
-        lines = [f"slave facet {c} (local cell index on rank {comm.rank}) with nodes "
-                 f"{np.array2string(xs[slave_cells[c]], precision=17, separator=', ')}"
-                 for c in r.degenerate_slave_facets[:5]]
-        lines = [line for rank_lines in comm.allgather(lines) for line in rank_lines]
-        # a master facet near several ranks' slave facets is named once (by its nodes)
-        master_lines: dict[str, str] = {}
-        for rank_lines in comm.allgather(
-                [(np.array2string(master_copy.x[master_copy.cells[c]], precision=17,
-                                  separator=', '), c) for c in r.degenerate_master_facets[:5]]):
-            for nodes, c in rank_lines:
-                master_lines.setdefault(nodes, f"master facet {c} (index in the received "
-                                               f"master facets) with nodes {nodes}")
-        lines += list(master_lines.values())
-        if lines:
-            raise DegenerateGeometryError(
-                f"degenerate contact facets (length or height at most the zero length "
-                f"{self.zero_length:.3g} = tolerance × length scale {self.length_scale:.3g}): "
-                + "; ".join(lines))
 
     @property
     def total_covered_area(self) -> float:
