@@ -115,12 +115,14 @@ def bisected_boxes(boxes: FloatArray, pieces: int = REGION_BOXES) -> FloatArray:
 
 
 def meeting(facet_boxes: FloatArray, region: FloatArray) -> npt.NDArray[np.bool_]:
-    """Which facet boxes meet any box of ``region`` (closed boxes)."""
-    if len(region) == 0 or len(facet_boxes) == 0:
-        return np.zeros(len(facet_boxes), dtype=bool)
-    lower = facet_boxes[:, None, :3] <= region[None, :, 3:]
-    upper = facet_boxes[:, None, 3:] >= region[None, :, :3]
-    return np.any(np.all(lower & upper, axis=2), axis=1)
+    """Which facet boxes meet any box of ``region`` (closed boxes), by the
+    kernels' bounding-box tree over the region."""
+    chosen = np.zeros(len(facet_boxes), dtype=bool)
+    if len(region) and len(facet_boxes):
+        pairs = np.asarray(_kernels.overlapping_box_pairs(
+            np.ascontiguousarray(facet_boxes), np.ascontiguousarray(region))).reshape(-1, 2)
+        chosen[pairs[:, 0]] = True
+    return chosen
 
 
 def largest_facet(surface: LagrangeSurface, x: FloatArray) -> float:
