@@ -14,20 +14,18 @@ from dolfinx_mortar import (ContactTerm, LoadPathSolver, NonlinearContactProblem
                             RigidPlane)
 from dolfinx_mortar.meshes.merge_meshes import merge_bodies
 from dolfinx_mortar.small_strain.elastic import linear_elastic_residual
-from support.meshes import rectangle
+from support.meshes import (BLOCK_BOTTOM, BLOCK_LEFT, BLOCK_OFFSET, BLOCK_TOP, rectangle,
+                           stacked_rectangles)
 
 #: each block's tags before the offset: bottom, top, left
-BOTTOM, TOP, LEFT = 1, 2, 3
-OFFSET = 10
+BOTTOM, TOP, LEFT = BLOCK_BOTTOM, BLOCK_TOP, BLOCK_LEFT
+OFFSET = BLOCK_OFFSET
 
 
 def three_blocks(comm, across: int = 8):
     """Three blocks [0,1] x [k/4, (k+1)/4] on 8, 9 and 10 cells across (non-matching):
     the default search radius, the largest facet (1/8), is below a block's thickness."""
-    meshes = [rectangle(comm, k / 4, (k + 1) / 4, (across + k, 2), bottom=BOTTOM, top=TOP,
-                        left=LEFT) for k in range(3)]
-    return merge_bodies([m for m, _ in meshes], [t for _, t in meshes],
-                        tag_offsets=[OFFSET * k for k in range(3)], shared_tags=[LEFT])
+    return stacked_rectangles(comm, [across + k for k in range(3)])
 
 
 def test_three_meshes_merge_in_one_call():

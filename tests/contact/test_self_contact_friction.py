@@ -11,24 +11,21 @@ from mpi4py import MPI
 from dolfinx import fem
 
 from dolfinx_mortar import ContactProblem, CoulombFriction
-from dolfinx_mortar.meshes.merge_meshes import merge_bodies
 from demo_support.self_mirror import BOTTOM as C_BOTTOM, CONTACT, SLAB, SYMMETRY_X, TOP as C_TOP, build
 from support import load_demo
-from support.meshes import rectangle
+from support.meshes import (BLOCK_BOTTOM, BLOCK_LEFT, BLOCK_OFFSET, BLOCK_RIGHT,
+                           BLOCK_TOP, stacked_rectangles)
 
 #: each block's tags before the offset: bottom, top, left, right
-BOTTOM, TOP, LEFT, RIGHT = 1, 2, 3, 4
-OFFSET = 10
+BOTTOM, TOP, LEFT, RIGHT = BLOCK_BOTTOM, BLOCK_TOP, BLOCK_LEFT, BLOCK_RIGHT
+OFFSET = BLOCK_OFFSET
 #: the pressure on the upper block's top, the shear of the stick test, μ
 Q, TAU, MU = 0.01, 0.002, 0.3
 
 
 def two_blocks(comm, lower: int, upper: int):
     """[0,1]×[0,1/4] on ``lower`` cells across under [0,1]×[1/4,1/2] on ``upper``."""
-    meshes = [rectangle(comm, k / 4, (k + 1) / 4, (n, 2), bottom=BOTTOM, top=TOP, left=LEFT,
-                        right=RIGHT) for k, n in enumerate((lower, upper))]
-    domain, tags, _ = merge_bodies([m for m, _ in meshes], [t for _, t in meshes],
-                                   tag_offsets=[0, OFFSET], shared_tags=[LEFT, RIGHT])
+    domain, tags, _ = stacked_rectangles(comm, [lower, upper], right=True)
     return fem.functionspace(domain, ("Lagrange", 1, (2,))), tags
 
 

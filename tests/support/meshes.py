@@ -50,3 +50,24 @@ def two_blocks(comm, dim, degree):
         V = fem.functionspace(domain, ("Lagrange", degree, (domain.geometry.dim,)))
         out.append((V, tags))
     return out
+
+
+#: the tags of each block of :func:`stacked_rectangles`, before its offset
+BLOCK_BOTTOM, BLOCK_TOP, BLOCK_LEFT, BLOCK_RIGHT = 1, 2, 3, 4
+#: block k's tags are the above plus k·BLOCK_OFFSET
+BLOCK_OFFSET = 10
+
+
+def stacked_rectangles(comm, cells_across, right: bool = False):
+    """Blocks [0,1] × [k/4, (k+1)/4], block k on ``cells_across[k]`` cells across (non-
+    matching where they differ), merged in one call: mesh, facet tags and cell tags. Each
+    block's bottom, top (and ``right``) faces tagged as above, the left faces (and right)
+    shared."""
+    from dolfinx_mortar.meshes.merge_meshes import merge_bodies
+    sides = dict(right=BLOCK_RIGHT) if right else {}
+    meshes = [rectangle(comm, k / 4, (k + 1) / 4, (n, 2), bottom=BLOCK_BOTTOM, top=BLOCK_TOP,
+                        left=BLOCK_LEFT, **sides) for k, n in enumerate(cells_across)]
+    shared = [BLOCK_LEFT] + ([BLOCK_RIGHT] if right else [])
+    return merge_bodies([m for m, _ in meshes], [t for _, t in meshes],
+                        tag_offsets=[BLOCK_OFFSET * k for k in range(len(meshes))],
+                        shared_tags=shared)
