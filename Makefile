@@ -130,17 +130,18 @@ test-python:
 test-mpi:
 	$(MPIRUN) $(PYTEST) -p no:cacheprovider tests
 
-# More ranks than cores (oversubscribed: correct, not fast; OMPI yields while it waits): the
-# surface exchange's invariants on 3 ranks (6 s), and the mirror, patch and friction tests on 4
-# (without the slowest: the pointwise mirrors and the refinement study; about 3 min).
+# More ranks than cores (tools/oversubscribed: correct, not fast; Open MPI yields while a rank
+# waits; a run past its time is started once more, saying so): the surface exchange's invariants
+# on 3 ranks (6 s), and the mirror, patch and friction tests on 4 (without the slowest: the
+# pointwise mirrors and the refinement study; 65-75 s alone on 2 cores).
 RANKS_TESTS_3 = tests/mortar/test_surface_exchange.py tests/mortar/test_mortar_parallel.py \
 	tests/contact/test_self_contact_friction.py tests/contact/test_many_bodies.py
 RANKS_TESTS_4 = tests/contact/test_mirror.py tests/solver/test_problem.py::test_patch_test_passes_with_the_consistent_scaling \
 	tests/solver/test_two_meshes.py::test_patch_test_on_two_meshes_matches_one_mesh \
 	tests/contact/test_friction_scenes.py tests/contact/test_self_contact_friction.py
 test-ranks:
-	OMPI_MCA_mpi_yield_when_idle=1 timeout 1200 mpirun -n 3 --oversubscribe $(PYTEST) -p no:cacheprovider $(RANKS_TESTS_3)
-	OMPI_MCA_mpi_yield_when_idle=1 timeout 1200 mpirun -n 4 --oversubscribe $(PYTEST) -p no:cacheprovider \
+	tools/oversubscribed 3 300 $(PYTEST) -p no:cacheprovider $(RANKS_TESTS_3)
+	tools/oversubscribed 4 600 $(PYTEST) -p no:cacheprovider \
 		-k "not pointwise and not under_refinement" $(RANKS_TESTS_4)
 
 test-coretype:
