@@ -45,13 +45,13 @@ share of the master surface, ``NearSurface``, or the whole master with
 ``whole_master``; and the slave facets near its own for the normal
 clusters). The script wraps ``MortarCoupling.__init__`` during the run and
 adds them up over every coupling made (``coupling_bytes``). The current
-configuration also gathers the whole slave surface outside any coupling
-(``gathered_pair_derivatives``): the script wraps ``gather_surface`` in
-``contact/gap_sources/current/mortar.py`` only and adds, per call, the bytes
-of the gathered node coordinates, global ids and volume cell ids that came from
-other ranks (all cells but the rank's own; ``gathers`` counts these calls).
-``bytes_received`` is the sum of both. Pickling adds about 150 bytes per array
-and rank, not counted.
+configuration also deals its pairs' Jet work out over the ranks, with the
+facets each pair reads, outside any coupling (``pair_share.deal_evenly``):
+the script wraps ``deal_evenly`` in ``contact/gap_sources/current/mortar.py``
+and adds the ``received_bytes`` of each call (``gathers`` counts these calls;
+before 2026-11-27 they were gathers of the whole slave surface, counted the
+same way). ``bytes_received`` is the sum of both. Pickling adds about 150
+bytes per array and rank, not counted.
 
 Waiting costs CPU time too: a rank waiting in a collective polls. Run with
 ``OMPI_MCA_mpi_yield_when_idle=1``: a test rank waiting 2 s for another was
@@ -79,8 +79,8 @@ from contact_parallel import rank_row
 from dolfinx_mortar.io.output import write_atomically, write_csv
 
 HERE = Path(__file__).resolve().parent
-#: the modules whose phase timings are read, and the one whose ``gather_surface``
-#: calls are outside any coupling
+#: the modules whose phase timings are read, and the one whose ``deal_evenly``
+#: calls exchange surface data outside any coupling
 CLOCKED = ("dolfinx_mortar.mortar.coupling", "dolfinx_mortar.contact.term",
            "dolfinx_mortar.solver.nonlinear_problem")
 GATHERING = ("dolfinx_mortar.contact.gap_sources.current.mortar",)
@@ -141,31 +141,20 @@ def replaced(owners: Sequence, name: str, make: Callable) -> Iterator[None]:
             setattr(module, name, old)
 
 
-def received_bytes(copy, own_cells: int) -> int:
-    """Bytes of a gathered surface copy (``SurfaceCopy``) that came from other
-    ranks: coordinates, global ids and volume cell ids (where gathered) of
-    every cell but the rank's own."""
-    cells = len(copy.cells)
-    if cells == 0:
-        return 0
-    volume = 0 if copy.volume_ids is None else copy.volume_ids.nbytes
-    return (cells - own_cells) * ((copy.x.nbytes + copy.global_ids.nbytes + volume) // cells)
-
-
-class GatherCount:
-    """Calls of ``gather_surface`` outside any coupling on this rank and the
+class ExchangeCount:
+    """Calls of ``deal_evenly`` (outside any coupling) on this rank and the
     bytes they received."""
 
     def __init__(self) -> None:
         self.calls, self.bytes = 0, 0
 
-    def wrap(self, gather: Callable) -> Callable:
-        @functools.wraps(gather)
-        def counted(surface, x):
-            copy = gather(surface, x)
+    def wrap(self, deal: Callable) -> Callable:
+        @functools.wraps(deal)
+        def counted(*args, **kwargs):
+            dealt = deal(*args, **kwargs)
             self.calls += 1
-            self.bytes += received_bytes(copy, len(surface.cells))
-            return copy
+            self.bytes += dealt.received_bytes
+            return dealt
         return counted
 
 
@@ -189,13 +178,13 @@ class CouplingLog:
 
 
 @contextmanager
-def measured(count: GatherCount, couplings: CouplingLog) -> Iterator[None]:
-    """The library's phase clocks on process time, its gathers outside the
+def measured(count: ExchangeCount, couplings: CouplingLog) -> Iterator[None]:
+    """The library's phase clocks on process time, its exchanges outside the
     couplings counted and its couplings logged, inside the block."""
     from dolfinx_mortar.mortar.coupling import MortarCoupling
     with ExitStack() as stack:
         stack.enter_context(replaced(CLOCKED, "time", lambda _: _ProcessClock()))
-        stack.enter_context(replaced(GATHERING, "gather_surface", count.wrap))
+        stack.enter_context(replaced(GATHERING, "deal_evenly", count.wrap))
         stack.enter_context(replaced([MortarCoupling], "__init__", couplings.wrap))
         yield
 
@@ -207,7 +196,7 @@ def hertz3d(args: argparse.Namespace, comm) -> dict:
     demo_args = demo.parse_args(["--obstacle", "elastic", "--refine", str(args.refine),
                                  "--penalty", str(args.penalty), "--linear-solver",
                                  "iterative", "--partitioner", args.partitioner])
-    count, couplings = GatherCount(), CouplingLog()
+    count, couplings = ExchangeCount(), CouplingLog()
     with measured(count, couplings):
         comm.Barrier()
         wall, cpu = time.perf_counter(), time.process_time()
@@ -239,7 +228,7 @@ def ironing3d(args: argparse.Namespace, comm) -> dict:
     demo_args = ironing.parse_args(ironing.__doc__, 3, [
         "--h", str(args.h), "--press-steps", str(args.press_steps),
         "--slide-steps", str(args.slide_steps), "--quiet"])
-    count, couplings = GatherCount(), CouplingLog()
+    count, couplings = ExchangeCount(), CouplingLog()
     with measured(count, couplings), replaced(["demo_support.ironing"],
                                               "NonlinearContactProblem", recording):
         comm.Barrier()

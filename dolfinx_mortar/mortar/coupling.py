@@ -117,10 +117,10 @@ class MortarCoupling:
         that are neighbours on the surface are never candidates
         (:func:`~dolfinx_mortar.mortar.facet_search.near_in_surface`).
     whole_master
-        Gather every rank's master facets on every rank (what the current
-        configuration's shared-out Jet work needs), instead of only those the
-        slave facets' search boxes meet, with a band of the largest master
-        facet (:class:`~dolfinx_mortar.mortar.surface_exchange.NearSurface`).
+        Gather every rank's master facets on every rank, instead of only those
+        the slave facets' search boxes meet, with a band of the largest master
+        facet (:class:`~dolfinx_mortar.mortar.surface_exchange.NearSurface`):
+        for comparisons.
 
     Raises
     ------
@@ -155,7 +155,13 @@ class MortarCoupling:
         comm = slave.layout.comm
         xs = current_coordinates(slave, slave_displacement)
         xm = current_coordinates(master, master_displacement)
-        clusters, slave_bytes = clusters_and_bytes(slave, xs)
+        clusters, slave_near = clusters_and_bytes(slave, xs)
+        slave_bytes = slave_near.received_bytes
+        #: the slave's normal clusters (global id → root id, the same on every
+        #: rank); the slave cells near this rank's (all around its nodes, and a
+        #: band), its own from ``first_own_slave_cell`` on: what its pairs' Jets read
+        self.clusters = clusters
+        self.slave_copy, self.first_own_slave_cell = slave_near.copy, slave_near.first_own_cell
         self.normals = averaged_nodal_normals(slave, xs, clusters)
         slave_cells = slave.cells.astype(np.int32)
         self.search_radius, slave_boxes = search_boxes(
@@ -169,9 +175,8 @@ class MortarCoupling:
         self.received_bytes = slave_bytes + master_bytes
         self.timings["normals_and_gather"] = time.perf_counter() - clock
         clock = time.perf_counter()
-        #: the master facets this rank's slave facets may reach, with a band
-        #: (all ranks' with ``whole_master``), one node copy per cell;
-        #: ``received_bytes``: what this rank received from the other ranks for
+        #: the master facets this rank's slave facets may reach, with a band, one
+        #: node copy per cell; ``received_bytes``: what this rank received for
         #: them and for the slave's normal clusters
         self.master_copy = master_copy
         self.master_global_ids = master_copy.global_ids

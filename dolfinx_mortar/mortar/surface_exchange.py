@@ -172,11 +172,15 @@ class NearSurface:
         :class:`~dolfinx_mortar.mortar.surface_normals.SurfaceCopy`.
     received_bytes
         Bytes of coordinates and node ids received from other ranks.
+    first_own_cell
+        Where this rank's own cells start in ``copy``: they all meet its
+        boxes, and follow in their order.
     """
 
     def __init__(self, surface: LagrangeSurface, x: FloatArray, search_boxes: FloatArray,
                  band: float, with_volume: bool = False):
         comm: MPI.Comm = surface.layout.comm
+        self.first_own_cell = 0
         if comm.size == 1:
             self.copy, self.received_bytes = gather_surface(surface, x, with_volume), 0
             return
@@ -201,6 +205,7 @@ class NearSurface:
                                       for rank, part in enumerate(incoming)
                                       if rank != comm.rank))
         nd = cells.shape[1]
+        self.first_own_cell = int(sum(len(part[0]) for part in incoming[:comm.rank]))
         global_ids = np.concatenate([part[0] for part in incoming]).reshape(-1, nd)
         nc = len(global_ids)
         xs = np.concatenate([part[1] for part in incoming]).reshape(nc * nd, x.shape[1])

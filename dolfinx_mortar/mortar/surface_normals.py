@@ -73,8 +73,11 @@ def normal_clusters(surface: LagrangeSurface, x: FloatArray) -> dict[int, int]:
     return clusters_and_bytes(surface, x)[0]
 
 
-def clusters_and_bytes(surface: LagrangeSurface, x: FloatArray) -> tuple[dict[int, int], int]:
-    """:func:`normal_clusters`, and the bytes this rank received for them."""
+def clusters_and_bytes(surface: LagrangeSurface, x: FloatArray
+                       ) -> tuple[dict[int, int], NearSurface]:
+    """:func:`normal_clusters`, and the copy of the surface near this rank's
+    cells they were found on (every cell around its nodes, and a band), with
+    the bytes it cost."""
     # the cells around this rank's nodes and a band beyond: a cluster is a few
     # facets a thousandth of their neighbours long, well inside the band
     own = (_kernels.facet_bounding_boxes(surface.facet_type, x, surface.cells.astype(np.int32),
@@ -90,7 +93,7 @@ def clusters_and_bytes(surface: LagrangeSurface, x: FloatArray) -> tuple[dict[in
     clusters: dict[int, int] = {}
     for part in surface.layout.comm.allgather(local):
         clusters.update(part)
-    return clusters, near.received_bytes
+    return clusters, near
 
 
 def cluster_diameters(surface: LagrangeSurface, clusters: dict[int, int],

@@ -30,7 +30,7 @@ def test_differentiable_gaps_equal_the_kernels(kind, degree):
     model = problem.gap_model
     data = state.data.source.data
     kernel = (data.coupling.raw_pairs[2] @ model.C)[data.pairs]
-    jet = model.pair_derivatives(data.u_nodes, data.coupling, data.kept,
+    jet = model.pair_derivatives(data.coupling, data.kept,
                                  with_hessian=False).value @ model.C
     scale = problem.mesh.comm.allreduce(float(np.max(np.abs(kernel), initial=0.0)), op=MPI.MAX)
     error = problem.mesh.comm.allreduce(float(np.max(np.abs(kernel - jet), initial=0.0)),
@@ -62,14 +62,14 @@ def test_missing_the_normal_linearization_is_detected():
     through the neighbouring slave cells' nodes, and it does."""
     problem = sheared_blocks("LmLS*")
     model = problem.gap_model
-    exact = model.gathered_pair_derivatives
+    exact = model.dealt_pair_derivatives
     # the same direction both times (fixed seeds): only the normals' terms differ
     exact_error = energy_gradient_error(problem)
 
-    def frozen_normals(u_nodes, coupling, gathered_pairs, with_hessian, **options):
+    def frozen_normals(dealt, zero_length, with_hessian, **options):
         """Neighbour nodes held at their values: the normals lose part of their
         derivatives (the slave cell's own and the master's nodes keep theirs)."""
-        exact_r = exact(u_nodes, coupling, gathered_pairs, with_hessian, **options)
+        exact_r = exact(dealt, zero_length, with_hessian, **options)
         r = SimpleNamespace(**{name: getattr(exact_r, name) for name in (
             "nodes", "value", "gradient", "hessian", "value_plus", "gradient_plus")})
         ns, nm, gdim = model.slave.cells.shape[1], 2, 2
@@ -82,7 +82,7 @@ def test_missing_the_normal_linearization_is_detected():
         r.gradient = np.where(columns[:, None, :], 0.0, r.gradient)
         return r
 
-    model.gathered_pair_derivatives = frozen_normals
+    model.dealt_pair_derivatives = frozen_normals
     # measured 3.3e-7 against 3e-10 serial with the Python Jets; 9.8e-8 on one
     # 2-rank partition, so the bound is relative to the exact error
     frozen_error = energy_gradient_error(problem)
@@ -180,7 +180,7 @@ def test_current_mortar_3d_is_the_kernel_and_its_exact_derivatives(kind, scaling
     model = problem.gap_model
     data = state.data.source.data
     kernel = (data.coupling.raw_pairs[2] @ model.C)[data.pairs]
-    jet = model.pair_derivatives(data.u_nodes, data.coupling, data.kept,
+    jet = model.pair_derivatives(data.coupling, data.kept,
                                  with_hessian=False).value @ model.C
     comm = problem.mesh.comm
     scale = comm.allreduce(float(np.max(np.abs(kernel), initial=0.0)), op=MPI.MAX)

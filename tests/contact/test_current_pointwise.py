@@ -51,7 +51,7 @@ def test_kernel_positive_part_is_the_points_sum():
     expected = np.zeros((len(data.coupling.pairs), model.slave.cells.shape[1]))
     np.add.at(expected, points.pairs,
               (points.weights * np.maximum(points.gap, 0.0))[:, None] * points.slave_N)
-    kernel = model.pair_derivatives(data.u_nodes, data.coupling, data.kept,
+    kernel = model.pair_derivatives(data.coupling, data.kept,
                                     with_hessian=False, with_positive_part=True).value_plus
     comm = problem.mesh.comm
     scale = comm.allreduce(float(np.max(np.abs(expected), initial=0.0)), op=MPI.MAX)

@@ -1,6 +1,7 @@
 """Each rank's share of the master surface (:mod:`dolfinx_mortar.mortar.surface_exchange`):
 what a coupling finds with it is what it finds with the whole surface gathered, pair for
-pair, and the band brings every neighbour of a paired facet. Run on 1, 2 and 3 ranks."""
+pair, and the band brings every neighbour of a paired facet; and the pairs' Jet work dealt
+out over the ranks (:mod:`dolfinx_mortar.mortar.pair_share`). Run on 1, 2 and 3 ranks."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,7 +10,8 @@ from mpi4py import MPI
 
 from demo_support.self_mirror import CONTACT, build
 from dolfinx import fem
-from dolfinx_mortar.mortar.coupling import MortarCoupling
+from dolfinx_mortar.mortar.coupling import MortarCoupling, polynomial_degree, segment_quadrature
+from dolfinx_mortar.mortar.pair_share import deal_evenly, own_pairs
 from dolfinx_mortar.mortar.surface_exchange import bisected_boxes
 from dolfinx_mortar.surfaces.facet_surface import facet_surface
 from support.meshes import MASTER, SLAVE, two_blocks
@@ -72,3 +74,48 @@ def test_a_rank_pairs_its_share_of_the_master_as_the_whole_master(scene):
     assert share.received_bytes <= whole.received_bytes
     if MPI.COMM_WORLD.size == 1:
         assert share.received_bytes == whole.received_bytes == 0
+
+
+def contracted(jets, gdim: int) -> np.ndarray:
+    """Each pair's gradients contracted with a field of the global dofs: the
+    same whatever order the kernel lists a pair's variable nodes in."""
+    nodes = np.maximum(jets.nodes, 0)
+    field = np.sin(1.0 + (nodes[..., None] * gdim + np.arange(gdim))).reshape(len(nodes), -1)
+    return np.einsum("pak,pk->pa", jets.gradient, field)
+
+
+@pytest.mark.parametrize("scene", [two_block_surfaces, c_body], ids=["3d-blocks", "self"])
+def test_pairs_dealt_to_another_rank_have_the_jets_their_own_rank_computes(scene):
+    """The current configuration's Jet work dealt out over the ranks
+    (:func:`~dolfinx_mortar.mortar.pair_share.deal_evenly`): every pair is dealt
+    once, in shares that differ by at most one, and on the rank it is dealt to
+    each pair's gap and gradient are those its own rank computes with every
+    slave cell around it: the cells dealt along are enough for the averaged
+    normals and their derivatives; nothing else arrives."""
+    slave, master, options = scene()
+    comm = MPI.COMM_WORLD
+    coupling = MortarCoupling(slave, master, **options)
+    points, weights = segment_quadrature(slave.tdim, 2 * polynomial_degree(slave))
+    jets = {"axisymmetric": slave.axisymmetric, "with_hessian": False}
+    # the pairs of every other slave cell: the cells around theirs are not theirs
+    which = coupling.pairs[:, 0] % 2 == 0
+    own = own_pairs(coupling, which).gap_jets(points, weights, coupling.zero_length, **jets)
+    dealt = deal_evenly(coupling, which, own.value, contracted(own, slave.gdim))
+    here = dealt.gap_jets(points, weights, coupling.zero_length, **jets)
+    shares = comm.allgather(len(dealt.pairs))
+    assert sum(shares) == comm.allreduce(int(np.sum(which))) > 0
+    assert max(shares) - min(shares) <= 1
+    value, gradient = dealt.values
+    scale = comm.allreduce(float(np.max(np.abs(own.value), initial=0.0)), op=MPI.MAX)
+    assert np.allclose(here.value, value, rtol=0, atol=1e-12 * scale)
+    scale = comm.allreduce(float(np.max(np.abs(gradient), initial=0.0)), op=MPI.MAX)
+    assert np.allclose(contracted(here, slave.gdim), gradient, rtol=0, atol=1e-12 * scale)
+    assert np.array_equal(dealt.rows, dealt.slave.global_ids[dealt.slave.cells[dealt.pairs[:, 0]]])
+    if comm.size == 1:     # one rank keeps its pairs and its copies
+        assert dealt.received_bytes == 0
+        return
+    # what arrives is what the dealt pairs read, and no more: the cells around
+    # their slave nodes (these scenes have no normal clusters) and their master cells
+    ids = dealt.slave.global_ids[dealt.slave.cells]
+    assert np.all(np.isin(ids, dealt.rows).any(axis=1))
+    assert np.array_equal(np.unique(dealt.pairs[:, 1]), np.arange(len(dealt.master.cells)))

@@ -21,7 +21,6 @@ from typing import Optional
 
 import numpy as np
 import numpy.typing as npt
-from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
@@ -30,8 +29,8 @@ from dolfinx_mortar.contact.gap_sources.current.finite_deformation import Curren
 from dolfinx_mortar.contact.laws import PenaltyLaw, safe_weights
 from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
-from dolfinx_mortar.mortar.coupling import (MortarCoupling, gather_surface, polynomial_degree,
-                                            segment_quadrature)
+from dolfinx_mortar.mortar.coupling import MortarCoupling, polynomial_degree, segment_quadrature
+from dolfinx_mortar.mortar.pair_share import DealtPairs, deal_evenly, own_pairs
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
 FloatArray = npt.NDArray[np.float64]
@@ -45,26 +44,15 @@ SUPPORTED_3D = ("P1 triangle", "Q1 quadrilateral")
 FACET_SEARCH_FACTOR = 2.0
 
 
-def share_evenly(comm: MPI.Comm, *per_pair: npt.NDArray) -> tuple[npt.NDArray, ...]:
-    """This rank's equal share (by count, in rank order) of all ranks' rows of
-    the given per-pair arrays (pairs, weights, ...). Collective."""
-    if comm.size == 1:
-        return per_pair
-    total = comm.allreduce(len(per_pair[0]))
-    start, end = total * comm.rank // comm.size, total * (comm.rank + 1) // comm.size
-    return tuple(np.concatenate(comm.allgather(np.asarray(a)))[start:end] for a in per_pair)
-
-
 @dataclass
 class KeptPairs:
     """The pairs of one evaluation whose derivatives were computed: their slave
-    cells, their indices in the coupling's pairs, the displacement and the
-    coupling they were found at, which of the coupling's pairs were kept, and
-    the global dofs of their variables."""
+    cells, their indices in the coupling's pairs, the coupling they were
+    found at, which of the coupling's pairs were kept, and the global dofs of
+    their variables."""
 
     cells: IntArray
     pairs: IntArray
-    u_nodes: FloatArray
     coupling: MortarCoupling
     kept: npt.NDArray[np.bool_]
     dofs: Optional[IntArray] = None
@@ -110,23 +98,23 @@ class CurrentMortarGap(CurrentSurfaceGap):
         degree = polynomial_degree(slave) + max(polynomial_degree(slave),
                                                  polynomial_degree(master))
         self.segment_points, self.segment_weights = segment_quadrature(slave.tdim, degree)
-        comm = slave.layout.comm
-        #: index of this rank's first slave cell in the gathered slave surface
-        self._first_cell = comm.scan(len(slave.cells)) - len(slave.cells)
-        #: global function ids of the gathered slave surface's cells (rows of
-        #: pairs computed on another rank than the one that holds them)
-        self._gathered_slave_ids = np.concatenate(
-            comm.allgather(slave.layout.global_indices[slave.cells])).reshape(
-                -1, slave.cells.shape[1])
-
-    def pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
+    def pair_derivatives(self, coupling: MortarCoupling,
                          which: Optional[npt.NDArray[np.bool_]] = None,
-                         with_hessian: bool = True, with_positive_part: bool = False,
-                         node_weights: Optional[FloatArray] = None
+                         with_hessian: bool = True, with_positive_part: bool = False
                          ) -> _kernels.PairGapDerivatives:
-        """``c_A = ∫ N_A d`` of the pairs of ``coupling`` (all, or those where
-        ``which`` is True) with exact derivatives (the Hessians only with
-        ``with_hessian``).
+        """``c_A = ∫ N_A d`` of this rank's pairs of ``coupling`` (all, or those
+        where ``which`` is True) with exact derivatives, computed here
+        (:meth:`dealt_pair_derivatives`)."""
+        return self.dealt_pair_derivatives(own_pairs(coupling, which), coupling.zero_length,
+                                           with_hessian, with_positive_part)
+
+    def dealt_pair_derivatives(self, dealt: DealtPairs, zero_length: float,
+                               with_hessian: bool, with_positive_part: bool = False,
+                               node_weights: Optional[FloatArray] = None
+                               ) -> _kernels.PairGapDerivatives:
+        """``c_A = ∫ N_A d`` of the pairs ``dealt`` to this rank (any rank's:
+        :func:`~dolfinx_mortar.mortar.pair_share.deal_evenly`) with exact
+        derivatives (the Hessians only with ``with_hessian``).
 
         Returns the kernel's typed result: ``value`` (pairs, ns), ``gradient``
         (pairs, ns, nv), ``hessian`` (pairs, ns, nv, nv) and ``nodes`` (pairs,
@@ -136,30 +124,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
         With ``node_weights`` (pairs, ns): those of the one function
         ``Σ_A w_A c_A`` per pair instead (ns = 1), what a Newton matrix needs.
         """
-        pairs = coupling.pairs if which is None else coupling.pairs[which]
-        return self.gathered_pair_derivatives(u_nodes, coupling,
-                                              pairs + np.array([self._first_cell, 0]),
-                                              with_hessian, with_positive_part, node_weights)
-
-    def gathered_pair_derivatives(self, u_nodes: FloatArray, coupling: MortarCoupling,
-                                  gathered_pairs: npt.NDArray[np.int64], with_hessian: bool,
-                                  with_positive_part: bool = False,
-                                  node_weights: Optional[FloatArray] = None
-                                  ) -> _kernels.PairGapDerivatives:
-        """:meth:`pair_derivatives` of pairs given in the gathered numbering
-        (slave cell of the gathered slave surface, master cell): any rank can
-        compute any rank's pairs, as every rank holds both gathered surfaces.
-        Collective (the slave surface is gathered at u)."""
-        slave = self.slave
-        copy = gather_surface(slave, self.local_x + u_nodes)
-        master = coupling.master_copy
-        return _kernels.current_pair_gaps(
-            slave.facet_type, copy.x, copy.cells, copy.global_ids.astype(np.int64),
-            master.facet_type, master.x, master.cells, master.global_ids.astype(np.int64),
-            np.asarray(gathered_pairs, dtype=np.int32).reshape(-1, 2), self.segment_points,
-            self.segment_weights, coupling.zero_length, with_hessian=with_hessian,
-            with_positive_part=with_positive_part, axisymmetric=slave.axisymmetric,
-            node_weights=node_weights)
+        return dealt.gap_jets(self.segment_points, self.segment_weights, zero_length,
+                              with_hessian=with_hessian, with_positive_part=with_positive_part,
+                              axisymmetric=self.slave.axisymmetric, node_weights=node_weights)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, W: FloatArray,
@@ -174,8 +141,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
                                   facet_search_factor=(FACET_SEARCH_FACTOR
                                                        if self.search_radius is None
                                                        else None),
-                                  keep_points=self.pointwise, self_contact=self.self_contact,
-                                  whole_master=True)
+                                  keep_points=self.pointwise, self_contact=self.self_contact)
         all_cells = slave.cells[coupling.pairs[:, 0]]
         # the values of every pair from the double kernel; derivatives only
         # where a node may carry contact force or stiffness
@@ -192,14 +158,14 @@ class CurrentMortarGap(CurrentSurfaceGap):
         kept = np.any(near[all_cells], axis=1)
         cells = all_cells[kept]
         ns = cells.shape[1]
-        data = KeptPairs(cells, np.flatnonzero(kept), u_nodes, coupling, kept)
+        data = KeptPairs(cells, np.flatnonzero(kept), coupling, kept)
         g_plus = G_g_plus = None
         # the residual needs gradients only; _gap_hessian asks for the Hessians
         # when (and if) a Jacobian is assembled at this u
         if self.pointwise:
             # ĝ⁺ is summed at the nodes from the kept pairs' values, on the
             # rank that holds the pairs (not shared out: see _gap_hessian)
-            r = self.pair_derivatives(u_nodes, coupling, kept, with_hessian=False,
+            r = self.pair_derivatives(coupling, kept, with_hessian=False,
                                       with_positive_part=True)
             dofs = self._variable_dofs(r.nodes, len(cells))
             nv = dofs.shape[1]
@@ -214,15 +180,14 @@ class CurrentMortarGap(CurrentSurfaceGap):
             # the gradients are shared out over the ranks like the Hessians
             # (_gap_hessian): 25 times the cost of the values, where the
             # surfaces press, often on one rank
-            pairs, = share_evenly(layout.comm,
-                                  coupling.pairs[kept] + np.array([self._first_cell, 0]))
-            r = self.gathered_pair_derivatives(u_nodes, coupling, pairs, with_hessian=False)
-            dofs = self._variable_dofs(r.nodes, len(pairs))
+            dealt = deal_evenly(coupling, kept)
+            r = self.dealt_pair_derivatives(dealt, coupling.zero_length, with_hessian=False)
+            n = len(dealt.pairs)
+            dofs = self._variable_dofs(r.nodes, n)
             nv = dofs.shape[1]
             # φ_a = Σ_b N_b C_ba
-            grad = np.einsum("pbn,ba->pan", r.gradient.reshape(len(pairs), ns, nv), self.C)
-            G_g = assemble_global_blocks(layout, self._gathered_slave_ids[pairs[:, 0]], dofs,
-                                         grad, cols=self.dofs)
+            grad = np.einsum("pbn,ba->pan", r.gradient.reshape(n, ns, nv), self.C)
+            G_g = assemble_global_blocks(layout, dealt.rows, dofs, grad, cols=self.dofs)
         data.dofs = dofs
         return SourceGaps(g, G_g, layout.on_cells(all_cells), g_plus, G_g_plus, data)
 
@@ -269,16 +234,16 @@ class CurrentMortarGap(CurrentSurfaceGap):
         # (100-200 times the cost of its values) is skipped. On Hertz 3D these
         # are most of the pairs kept for the gradients.
         needed = np.any(Fg[cells] != 0.0, axis=1)
-        pairs = (data.coupling.pairs[data.pairs[needed]]
-                 + np.array([self._first_cell, 0]))
+        which = np.zeros(len(data.kept), dtype=bool)
+        which[data.pairs[needed]] = True
         # The Hessians are most of the contact work, and they sit where the
-        # surfaces press, often on one rank. Every rank holds both gathered
-        # surfaces and the blocks are added by global dof, so each rank takes
-        # an equal share of all ranks' pairs instead of its own.
-        pairs, weights = share_evenly(self.slave.layout.comm, pairs, weights[needed])
+        # surfaces press, often on one rank: each rank takes an equal share of
+        # all ranks' pairs, with the facets they read, instead of its own.
+        dealt = deal_evenly(data.coupling, which, weights[needed])
+        pairs, (weights,) = dealt.pairs, dealt.values
         # the kernel sums the weighted Hessians (one per pair, not ns)
-        r = self.gathered_pair_derivatives(data.u_nodes, data.coupling, pairs,
-                                           with_hessian=True, node_weights=weights)
+        r = self.dealt_pair_derivatives(dealt, data.coupling.zero_length, with_hessian=True,
+                                        node_weights=weights)
         n = len(pairs)
         dofs = self._variable_dofs(r.nodes, n)
         nv = dofs.shape[1]
