@@ -30,6 +30,7 @@ from dolfinx_mortar.bases.basis import MortarBasis
 from dolfinx_mortar.kinds import BasisKind, KindLike, is_global, kind_name, parse_kind
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 from dolfinx_mortar.layout import assemble_blocks
+from dolfinx_mortar.mortar.dealt_segmentation import dealt_segmentation, segmenter
 from dolfinx_mortar.mortar.degenerate_facets import raise_on_degenerate_facets
 from dolfinx_mortar.mortar.facet_search import candidate_pairs, near_in_surface, search_boxes
 # the surfaces' copies live in surface_exchange, their geometry in surface_normals;
@@ -121,6 +122,9 @@ class MortarCoupling:
         the slave facets' search boxes meet, with a band of the largest master
         facet (:class:`~dolfinx_mortar.mortar.surface_exchange.NearSurface`):
         for comparisons.
+    deal_segmentation
+        Segment all ranks' candidates in equal shares and return the pairs to
+        their slave facets' ranks (:mod:`~dolfinx_mortar.mortar.dealt_segmentation`).
 
     Raises
     ------
@@ -138,7 +142,7 @@ class MortarCoupling:
                  opposing_normals_only: bool = True, keep_points: bool = False,
                  facet_search_factor: Optional[float] = None,
                  interface_normals: bool = False, self_contact: bool = False,
-                 whole_master: bool = False):
+                 whole_master: bool = False, deal_segmentation: bool = False):
         if slave.gdim != master.gdim:
             raise ValueError(f"slave ({slave.gdim}D) and master ({master.gdim}D) surfaces "
                              "live in different dimensions")
@@ -196,16 +200,14 @@ class MortarCoupling:
                                 length_scale(xm[np.unique(master.cells)], comm))
         #: lengths at or below this are zero (docs/DESIGN.md, §Tolerances)
         self.zero_length = zero_length(self.length_scale)
-        def segment(normals: FloatArray, keep_points: bool,
-                    along_normals: bool) -> _kernels.MortarIntegrals:
-            return _kernels.mortar_integrals(slave.facet_type, xs, slave_cells, normals,
-                                             master.facet_type, master_copy.x,
-                                             master_copy.cells, candidates, points, weights,
-                                             opposing_normals_only,
-                                             length_scale=self.length_scale,
-                                             keep_points=keep_points,
-                                             axisymmetric=slave.axisymmetric,
-                                             project_along_normals=along_normals)
+        def segment(normals: FloatArray, keep: bool, along_normals: bool):
+            kernel = segmenter(slave, master, points, weights, opposing_normals_only,
+                               self.length_scale, along_normals)
+            if deal_segmentation and comm.size > 1:
+                return dealt_segmentation(comm, kernel, xs, slave_cells, normals, master_copy,
+                                          candidates, keep)
+            return kernel(xs, slave_cells, normals, master_copy.x, master_copy.cells,
+                          candidates, keep)
 
         r = segment(self.normals, keep_points and not interface_normals, False)
         if interface_normals:

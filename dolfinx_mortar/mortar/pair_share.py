@@ -158,7 +158,7 @@ def _nbytes(part: tuple) -> int:
 def _copy(like: SurfaceCopy, ids: IntArray, x: FloatArray) -> SurfaceCopy:
     """A surface copy of cells given by their node ids and coordinates."""
     nc, nd = ids.shape
-    return SurfaceCopy(like.facet_type, x.reshape(nc * nd, -1),
+    return SurfaceCopy(like.facet_type, x.reshape(nc * nd, like.x.shape[1]),
                        np.arange(nc * nd, dtype=np.int32).reshape(nc, nd), ids.ravel())
 
 

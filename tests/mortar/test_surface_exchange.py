@@ -119,3 +119,40 @@ def test_pairs_dealt_to_another_rank_have_the_jets_their_own_rank_computes(scene
     ids = dealt.slave.global_ids[dealt.slave.cells]
     assert np.all(np.isin(ids, dealt.rows).any(axis=1))
     assert np.array_equal(np.unique(dealt.pairs[:, 1]), np.arange(len(dealt.master.cells)))
+
+
+@pytest.mark.parametrize("scene", [two_block_surfaces, c_body], ids=["3d-blocks", "self"])
+def test_segmentation_dealt_out_gives_each_rank_the_pairs_it_segments_itself(scene):
+    """All ranks' candidates segmented in equal shares and sent back
+    (``deal_segmentation``): each rank gets the pairs, integrals, points and
+    failed projections that segmenting its own candidates gives, in the same
+    order, with the interface normals' two passes."""
+    slave, master, options = scene()
+    comm = MPI.COMM_WORLD
+    here, dealt = (MortarCoupling(slave, master, interface_normals=True, keep_points=True,
+                                  deal_segmentation=deal, **options) for deal in (False, True))
+    assert comm.allreduce(len(here.pairs)) > 0
+    assert np.array_equal(here.pairs, dealt.pairs)
+    assert here.failed_projections == dealt.failed_projections
+    for a, b in zip(here.raw_pairs + (here.area_pairs,), dealt.raw_pairs + (dealt.area_pairs,)):
+        scale = comm.allreduce(float(np.max(np.abs(a), initial=0.0)), op=MPI.MAX)
+        assert np.allclose(a, b, rtol=0, atol=1e-14 * scale)
+    assert np.array_equal(here.points.pairs, dealt.points.pairs)
+    for name in ("weights", "gap", "normals", "slave_N", "master_N"):
+        a, b = getattr(here.points, name), getattr(dealt.points, name)
+        scale = comm.allreduce(float(np.max(np.abs(a), initial=0.0)), op=MPI.MAX)
+        assert np.allclose(a, b, rtol=0, atol=1e-14 * scale), name
+
+
+def test_blocks_apart_deal_out_no_pair_and_no_candidate():
+    """Surfaces apart: no candidate to segment and no pair to deal, on any rank
+    (the current configuration evaluates such states before the bodies meet)."""
+    slave, master, _ = two_block_surfaces()
+    apart = master.moved(np.full_like(master.x, 10.0))
+    coupling = MortarCoupling(slave, apart, deal_segmentation=True)
+    assert coupling.num_candidates == 0 and len(coupling.pairs) == 0
+    assert coupling.D_pairs.shape[1:] == (slave.cells.shape[1],) * 2
+    dealt = deal_evenly(coupling, np.zeros(0, dtype=bool))
+    assert dealt.pairs.shape == (0, 2)
+    if MPI.COMM_WORLD.size > 1:
+        assert len(dealt.slave.cells) == 0 and len(dealt.master.cells) == 0

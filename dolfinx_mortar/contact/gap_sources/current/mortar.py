@@ -134,14 +134,16 @@ class CurrentMortarGap(CurrentSurfaceGap):
         slave, layout = self.slave, self.slave.layout
         # the pairs are found again at every evaluation, and only those near
         # contact matter: each facet searches two of its own diameters
-        # (unless the user set a radius), not the largest facet's
+        # (unless the user set a radius), not the largest facet's; the
+        # candidates are segmented in equal shares over the ranks
         coupling = MortarCoupling(self._local_slave.moved(u_nodes),
                                   self._local_master.moved(u_nodes),
                                   search_radius=self.search_radius,
                                   facet_search_factor=(FACET_SEARCH_FACTOR
                                                        if self.search_radius is None
                                                        else None),
-                                  keep_points=self.pointwise, self_contact=self.self_contact)
+                                  keep_points=self.pointwise, self_contact=self.self_contact,
+                                  deal_segmentation=True)
         all_cells = slave.cells[coupling.pairs[:, 0]]
         # the values of every pair from the double kernel; derivatives only
         # where a node may carry contact force or stiffness
