@@ -78,15 +78,24 @@ def dealt_segmentation(comm: MPI.Comm, segment: Segment, xs: FloatArray,
     outgoing = []
     for rank in range(comm.size):
         chosen = np.flatnonzero(destination == rank)
-        slave, slave_index = np.unique(candidates[chosen, 0], return_inverse=True)
-        masters, master_index = np.unique(candidates[chosen, 1], return_inverse=True)
+        slave, slave_index = _used(candidates[chosen, 0], len(slave_cells))
+        masters, master_index = _used(candidates[chosen, 1], len(master.cells))
         outgoing.append((xs[slave_cells[slave]], normals[slave_cells[slave]],
                          master.x[master.cells[masters]],
-                         np.column_stack([slave_index.ravel(), master_index.ravel()]),
-                         chosen, slave, masters))
+                         np.column_stack([slave_index, master_index]), chosen, slave, masters))
     incoming = comm.alltoall(outgoing)
     replies = _segment_parts(incoming, segment, keep_points)
     return _collect(comm.alltoall(replies), candidates, keep_points)
+
+
+def _used(cells: npt.NDArray, count: int) -> tuple[IntArray, IntArray]:
+    """The distinct cells among ``cells`` (of ``count``), ascending, and each
+    entry's place among them: ``np.unique(..., return_inverse=True)`` in O(n)
+    (a quarter of the segmentation's own time went to sorting them)."""
+    used = np.zeros(count, dtype=bool)
+    used[cells] = True
+    place = np.cumsum(used) - 1
+    return np.flatnonzero(used), place[cells]
 
 
 def _segment_parts(parts: list[tuple], segment: Segment, keep_points: bool) -> list[tuple]:
@@ -112,7 +121,7 @@ def _segment_parts(parts: list[tuple], segment: Segment, keep_points: bool) -> l
     sender = np.searchsorted(slave_first, pairs[:, 0], side="right") - 1
     # the candidate each pair came from: (slave, master) are distinct among them
     key = candidates[:, 0].astype(np.int64) * (len(master_x) + 1) + candidates[:, 1]
-    by_key = np.argsort(key)
+    by_key = np.argsort(key, kind="stable")   # runs by slave cell: timsort is near linear
     which = by_key[np.searchsorted(key[by_key], pairs[:, 0] * (len(master_x) + 1) + pairs[:, 1])]
     candidate_first = np.cumsum([0] + [len(p[3]) for p in parts])
     bad_slave = np.asarray(r.degenerate_slave_facets, dtype=np.int64)
