@@ -160,7 +160,6 @@ class MortarCoupling:
         xs = current_coordinates(slave, slave_displacement)
         xm = current_coordinates(master, master_displacement)
         clusters, slave_near = clusters_and_bytes(slave, xs)
-        slave_bytes = slave_near.received_bytes
         #: the slave's normal clusters (global id → root id, the same on every
         #: rank); the slave cells near this rank's (all around its nodes, and a
         #: band), its own from ``first_own_slave_cell`` on: what its pairs' Jets read
@@ -176,15 +175,14 @@ class MortarCoupling:
             near = NearSurface(master, xm, slave_boxes, largest_facet(master, xm),
                                with_volume=self_contact)
             master_copy, master_bytes = near.copy, near.received_bytes
-        self.received_bytes = slave_bytes + master_bytes
+        self.received_bytes = slave_near.received_bytes + master_bytes
         self.timings["normals_and_gather"] = time.perf_counter() - clock
         clock = time.perf_counter()
         #: the master facets this rank's slave facets may reach, with a band, one
         #: node copy per cell; ``received_bytes``: what this rank received for
-        #: them and for the slave's normal clusters
+        #: them, the slave's normal clusters and any dealt segmentation
         self.master_copy = master_copy
-        self.master_global_ids = master_copy.global_ids
-        self.master_cells = master_copy.cells
+        self.master_global_ids, self.master_cells = master_copy.global_ids, master_copy.cells
         candidates = candidate_pairs(slave_boxes, master_copy)
         if self_contact:
             # a surface against itself: a facet's neighbours are never its partners
@@ -204,8 +202,10 @@ class MortarCoupling:
             kernel = segmenter(slave, master, points, weights, opposing_normals_only,
                                self.length_scale, along_normals)
             if deal_segmentation and comm.size > 1:
-                return dealt_segmentation(comm, kernel, xs, slave_cells, normals, master_copy,
-                                          candidates, keep)
+                dealt = dealt_segmentation(comm, kernel, xs, slave_cells, normals, master_copy,
+                                           candidates, keep)
+                self.received_bytes += dealt.received_bytes
+                return dealt
             return kernel(xs, slave_cells, normals, master_copy.x, master_copy.cells,
                           candidates, keep)
 

@@ -52,6 +52,8 @@ class Segmentation:
     point_normals: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
     point_slave_N: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
     point_master_N: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    #: bytes this rank received from the others: candidates to segment, and pairs back
+    received_bytes: int = 0
 
 
 def segmenter(slave, master, points: FloatArray, weights: FloatArray,
@@ -84,8 +86,16 @@ def dealt_segmentation(comm: MPI.Comm, segment: Segment, xs: FloatArray,
                          master.x[master.cells[masters]],
                          np.column_stack([slave_index, master_index]), chosen, slave, masters))
     incoming = comm.alltoall(outgoing)
-    replies = _segment_parts(incoming, segment, keep_points)
-    return _collect(comm.alltoall(replies), candidates, keep_points)
+    replies = comm.alltoall(_segment_parts(incoming, segment, keep_points))
+    result = _collect(replies, candidates, keep_points)
+    result.received_bytes = sum(_nbytes(part) for rank, part in enumerate(incoming + replies)
+                                if rank % comm.size != comm.rank)
+    return result
+
+
+def _nbytes(part: tuple) -> int:
+    """Bytes of the arrays in an exchanged part."""
+    return sum(np.asarray(a).nbytes for a in part)
 
 
 def _used(cells: npt.NDArray, count: int) -> tuple[IntArray, IntArray]:

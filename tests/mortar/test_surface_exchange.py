@@ -134,6 +134,8 @@ def test_segmentation_dealt_out_gives_each_rank_the_pairs_it_segments_itself(sce
     assert comm.allreduce(len(here.pairs)) > 0
     assert np.array_equal(here.pairs, dealt.pairs)
     assert here.failed_projections == dealt.failed_projections
+    # what travels for the segmentation is counted
+    assert (dealt.received_bytes > here.received_bytes) == (comm.size > 1)
     for a, b in zip(here.raw_pairs + (here.area_pairs,), dealt.raw_pairs + (dealt.area_pairs,)):
         scale = comm.allreduce(float(np.max(np.abs(a), initial=0.0)), op=MPI.MAX)
         assert np.allclose(a, b, rtol=0, atol=1e-14 * scale)
