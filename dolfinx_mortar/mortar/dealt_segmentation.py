@@ -77,19 +77,25 @@ def dealt_segmentation(comm: MPI.Comm, segment: Segment, xs: FloatArray,
     """Segment all ranks' ``candidates`` (slave cell, master cell of ``master``)
     in equal shares, and return this rank's pairs (collective)."""
     destination = share_owners(comm, len(candidates))
-    outgoing = []
+    outgoing, kept = [], []
     for rank in range(comm.size):
         chosen = np.flatnonzero(destination == rank)
         slave, slave_index = _used(candidates[chosen, 0], len(slave_cells))
         masters, master_index = _used(candidates[chosen, 1], len(master.cells))
+        # what travels: the cells once each, and 8 bytes a candidate
         outgoing.append((xs[slave_cells[slave]], normals[slave_cells[slave]],
                          master.x[master.cells[masters]],
-                         np.column_stack([slave_index, master_index]), chosen, slave, masters))
+                         np.column_stack([slave_index, master_index]).astype(np.int32)))
+        kept.append((chosen, slave, masters))
     incoming = comm.alltoall(outgoing)
     replies = comm.alltoall(_segment_parts(incoming, segment, keep_points))
+    received = sum(_nbytes(part) for rank, part in enumerate(incoming + replies)
+                   if rank % comm.size != comm.rank)
+    # back in this rank's numbering: candidates, slave cells, master cells
+    replies = [(chosen[r[0]], *r[1:6], slave[r[6]], masters[r[7]], *r[8:])
+               for (chosen, slave, masters), r in zip(kept, replies)]
     result = _collect(replies, candidates, keep_points)
-    result.received_bytes = sum(_nbytes(part) for rank, part in enumerate(incoming + replies)
-                                if rank % comm.size != comm.rank)
+    result.received_bytes = int(received)
     return result
 
 
@@ -140,13 +146,14 @@ def _segment_parts(parts: list[tuple], segment: Segment, keep_points: bool) -> l
     replies = []
     for k, part in enumerate(parts):
         mine = np.flatnonzero(sender == k)
-        reply = [part[4][which[mine] - candidate_first[k]]]
+        # in the sender's part: its candidate, its slave and master cells
+        reply = [(which[mine] - candidate_first[k]).astype(np.int32)]
         reply += [np.asarray(getattr(r, name))[mine] for name in PAIR_FIELDS]
         reply.append(int(r.failed_projections) if k == 0 else 0)
         in_part = (bad_slave >= slave_first[k]) & (bad_slave < slave_first[k + 1])
-        reply.append(part[5][bad_slave[in_part] - slave_first[k]])
+        reply.append(bad_slave[in_part] - slave_first[k])
         in_part = (bad_master >= master_first[k]) & (bad_master < master_first[k + 1])
-        reply.append(part[6][bad_master[in_part] - master_first[k]])
+        reply.append(bad_master[in_part] - master_first[k])
         if keep_points:
             at = np.isin(points, mine)
             reply.append(np.searchsorted(mine, points[at]))
