@@ -133,7 +133,9 @@ test-mpi:
 # More ranks than cores (tools/oversubscribed: correct, not fast; Open MPI yields while a rank
 # waits; a run past its time is started once more, saying so): the surface exchange's invariants
 # on 3 ranks (6 s), and the mirror, patch and friction tests on 4 (without the slowest: the
-# pointwise mirrors and the refinement study; 65-75 s alone on 2 cores).
+# pointwise mirrors and the refinement study; 65-75 s alone on 2 cores). Nor the 3D sphere
+# mirrors: on 4 ranks sid's Open MPI 6.0.0rc2 spun in sched_yield for minutes three times in
+# them (tests 44-49 of the step; CI timed out at 20 min); they run on 1 and 2 ranks.
 RANKS_TESTS_3 = tests/mortar/test_surface_exchange.py tests/mortar/test_mortar_parallel.py \
 	tests/contact/test_self_contact_friction.py tests/contact/test_many_bodies.py
 RANKS_TESTS_4 = tests/contact/test_mirror.py tests/solver/test_problem.py::test_patch_test_passes_with_the_consistent_scaling \
@@ -141,8 +143,8 @@ RANKS_TESTS_4 = tests/contact/test_mirror.py tests/solver/test_problem.py::test_
 	tests/contact/test_friction_scenes.py tests/contact/test_self_contact_friction.py
 test-ranks:
 	tools/oversubscribed 3 300 $(PYTEST) -p no:cacheprovider $(RANKS_TESTS_3)
-	tools/oversubscribed 4 600 $(PYTEST) -p no:cacheprovider \
-		-k "not pointwise and not under_refinement" $(RANKS_TESTS_4)
+	tools/oversubscribed 4 400 $(PYTEST) -p no:cacheprovider \
+		-k "not pointwise and not under_refinement and not spheres_in_3d" $(RANKS_TESTS_4)
 
 test-coretype:
 	@coretype=$(or $(SECOND_CORETYPE),$$($(PYTHON) tools/second_coretype.py)) && \
