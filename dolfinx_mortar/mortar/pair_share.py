@@ -20,7 +20,7 @@ layout) do not describe.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Optional
+from typing import Any, Optional, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -29,11 +29,24 @@ from mpi4py import MPI
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.mortar.surface_exchange import SurfaceCopy
 
-if TYPE_CHECKING:
-    from dolfinx_mortar.mortar.coupling import MortarCoupling
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
+
+
+class FoundPairs(Protocol):
+    """What dealing reads of a coupling
+    (:class:`~dolfinx_mortar.mortar.coupling.MortarCoupling` answers it): its
+    pairs (local slave cell, master copy cell), its copies of the slave near
+    this rank (own cells from ``first_own_slave_cell`` on) and of the master,
+    the slave's normal clusters, and the slave surface."""
+
+    pairs: npt.NDArray[np.int64]
+    first_own_slave_cell: int
+    slave_copy: SurfaceCopy
+    master_copy: SurfaceCopy
+    clusters: dict[int, int]
+    slave: Any
 
 
 @dataclass
@@ -77,7 +90,7 @@ class DealtPairs:
             self.pairs, points, weights, zero_length, **options)
 
 
-def own_pairs(coupling: "MortarCoupling", which: Optional[npt.NDArray[np.bool_]] = None,
+def own_pairs(coupling: FoundPairs, which: Optional[npt.NDArray[np.bool_]] = None,
               *values: npt.NDArray) -> DealtPairs:
     """The coupling's pairs (those where ``which`` is True) on the rank that
     found them: its slave cells in the coupling's copy of the slave surface
@@ -88,7 +101,7 @@ def own_pairs(coupling: "MortarCoupling", which: Optional[npt.NDArray[np.bool_]]
                       tuple(values))
 
 
-def deal_evenly(coupling: "MortarCoupling", which: npt.NDArray[np.bool_],
+def deal_evenly(coupling: FoundPairs, which: npt.NDArray[np.bool_],
                 *values: npt.NDArray) -> DealtPairs:
     """All ranks' pairs where ``which`` is True, dealt out in equal shares (by
     count, in rank order) with the facets they read and ``values`` (one row per
