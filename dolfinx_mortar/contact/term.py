@@ -231,6 +231,7 @@ class ContactTerm:
         if self.friction is not None:
             self.friction.accept(state.friction, self.u)
         self._checks.warn_if_slipped_too_far(state)
+        self._checks.missed.step_accepted()
 
     def check_path(self, deepest: tuple[float, float, list]) -> None:
         """Called when a load path ends: warn if the penalty let the bodies

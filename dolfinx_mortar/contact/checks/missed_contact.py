@@ -14,6 +14,14 @@ a slave node that lies behind the master by more than
 :data:`MISSED_DEPTH` of its element length while the term carries no pressure
 there is contact the pairs missed. The term then rebuilds its bases with a
 radius that covers the motion and the step is solved again (logged).
+
+On the current surface (``"current"``) the pairs are searched again at every
+evaluation, but each slave facet only reaches two of its own diameters: a load
+step that drives the surfaces through each other by more than that (a deep
+prescribed press in one step) left the nodes behind the master unpaired, the
+force exactly 0. The same check runs there with the motion since the last
+accepted step and the smallest facet's reach; the term is rebuilt with one
+radius that covers the motion.
 """
 from __future__ import annotations
 
@@ -24,7 +32,9 @@ from typing import Optional
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
+from petsc4py import PETSc
 
+from dolfinx_mortar.contact.gap_sources import FACET_SEARCH_FACTOR
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
@@ -57,12 +67,26 @@ class MissedContact:
         self.given_radius = term.options.search_radius
         self.widenings = 0
         self._warned = False
+        #: on the current surface: the displacement of the last accepted step
+        #: (None: the start), from which a step's motion is measured
+        self._accepted: Optional[PETSc.Vec] = None
+
+    def step_accepted(self) -> None:
+        """The present u is an accepted step (on the current surface, where the
+        next step's motion is measured from)."""
+        if self.configuration.follows_u:
+            if self._accepted is None:
+                self._accepted = self.term.u.x.petsc_vec.copy()
+            else:
+                self.term.u.x.petsc_vec.copy(self._accepted)
 
     def motion(self) -> float:
-        """The largest displacement of a slave or master node since the bases
-        were built, over all ranks (0 with nothing to compare)."""
+        """The largest displacement of a slave or master node since the pairs
+        were searched (since the bases were built; on the current surface, since
+        the last accepted step), over all ranks (0 with nothing to compare)."""
         term = self.term
-        built = self.configuration.built_vector
+        built = (self._accepted if self.configuration.follows_u
+                 else self.configuration.built_vector)
         if built is None:
             relative = term.u
         else:
@@ -92,19 +116,30 @@ class MissedContact:
         count = term.comm.allreduce(int(np.sum(missed[:n])))
         return count, term.results.deepest(np.where(missed, depth, -np.inf))
 
+    def searched_radius(self) -> float:
+        """How far every slave facet surely looked for the master (collective):
+        the frozen bases' search radius; on the current surface the radius given,
+        or :data:`FACET_SEARCH_FACTOR` diameters of the smallest slave facet
+        where it is now (each facet searches that many of its own)."""
+        term = self.term
+        coupling = (None if self.configuration.follows_u
+                    else self.configuration.segmentation(term.source))
+        if coupling is not None:
+            return coupling.search_radius
+        if term.options.search_radius is not None:
+            return term.options.search_radius
+        slave = term.slave
+        x = slave.x + nodal_displacement(slave, term.u)
+        local = float(np.min(np.max(np.ptp(x[slave.cells], axis=1), axis=1), initial=np.inf))
+        return FACET_SEARCH_FACTOR * term.comm.allreduce(local, op=MPI.MIN)
+
     def wider_radius(self, state: ContactState) -> Optional[float]:
         """After a converged step: the search radius the bases need where
         contact was missed (:meth:`missed`), None where none was (collective)."""
         term = self.term
-        # on the current surface the pairs are searched where the surfaces are, at every
-        # evaluation: nothing was built elsewhere to miss contact from
-        if term.master is None or self._warned or self.configuration.follows_u:
+        if term.master is None or self._warned:
             return None
-        coupling = self.configuration.segmentation(term.source)
-        # the current surface's own radius is not kept: twice its largest element
-        radius = (coupling.search_radius if coupling is not None
-                  else 2.0 * term.comm.allreduce(float(np.max(term.results.node_lengths(),
-                                                               initial=0.0)), op=MPI.MAX))
+        radius = self.searched_radius()
         motion = self.motion()
         if 2.0 * motion <= radius:
             # no slave node can have reached a master facet that lay beyond the

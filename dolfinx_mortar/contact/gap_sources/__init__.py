@@ -10,5 +10,7 @@ a source's bases are made again is its configuration's (:mod:`.configuration`).
 from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
 from dolfinx_mortar.contact.gap_sources.source import GapSource, GlobalGapSource
 from dolfinx_mortar.contact.gap_sources.configuration import configuration_of
+from dolfinx_mortar.contact.gap_sources.current.mortar import FACET_SEARCH_FACTOR
 
-__all__ = ["GapSource", "GlobalGapSource", "SlipOperator", "StepStart", "configuration_of"]
+__all__ = ["FACET_SEARCH_FACTOR", "GapSource", "GlobalGapSource", "SlipOperator", "StepStart",
+           "configuration_of"]
