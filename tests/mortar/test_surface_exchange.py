@@ -40,6 +40,11 @@ def two_block_surfaces():
     return facet_surface(Vs, ts, SLAVE), facet_surface(Vm, tm, MASTER), {}
 
 
+def quadratic_block_surfaces():
+    (Vs, ts), (Vm, tm) = two_blocks(MPI.COMM_WORLD, 3, 2)
+    return facet_surface(Vs, ts, SLAVE), facet_surface(Vm, tm, MASTER), {}
+
+
 def c_body():
     domain, tags = build(MPI.COMM_WORLD, 0.05, whole=True)
     surface = facet_surface(fem.functionspace(domain, ("Lagrange", 1, (2,))), tags, CONTACT)
@@ -121,12 +126,14 @@ def test_pairs_dealt_to_another_rank_have_the_jets_their_own_rank_computes(scene
     assert np.array_equal(np.unique(dealt.pairs[:, 1]), np.arange(len(dealt.master.cells)))
 
 
-@pytest.mark.parametrize("scene", [two_block_surfaces, c_body], ids=["3d-blocks", "self"])
+@pytest.mark.parametrize("scene", [two_block_surfaces, quadratic_block_surfaces, c_body],
+                         ids=["3d-blocks", "3d-quadratic-blocks", "self"])
 def test_segmentation_dealt_out_gives_each_rank_the_pairs_it_segments_itself(scene):
     """All ranks' candidates segmented in equal shares and sent back
-    (``deal_segmentation``): each rank gets the pairs, integrals, points and
-    failed projections that segmenting its own candidates gives, in the same
-    order, with the interface normals' two passes."""
+    (``deal_segmentation``, what every configuration uses): each rank gets the
+    pairs, integrals, points and failed projections that segmenting its own
+    candidates gives, in the same order, with the interface normals' two
+    passes; with quadratic facets (P2 triangles against 9-node quadrilaterals) too."""
     slave, master, options = scene()
     comm = MPI.COMM_WORLD
     here, dealt = (MortarCoupling(slave, master, interface_normals=True, keep_points=True,

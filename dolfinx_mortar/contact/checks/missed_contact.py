@@ -104,7 +104,7 @@ class MissedContact:
         term = self.term
         moved = [nodal_displacement(surface, term.u) for surface in (term.slave, term.master)]
         probe = MortarCoupling(term.slave, term.master, *moved, search_radius=radius,
-                               self_contact=term.options.self_contact)
+                               self_contact=term.options.self_contact, deal_segmentation=True)
         gap = probe.operators("LmLS*").nodal_gap()          # ∫N_A d over the covered part
         covered = probe.covered_element_mass()[2]           # ∫_cov N_A
         depth = np.full(len(covered), -np.inf)

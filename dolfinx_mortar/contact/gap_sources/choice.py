@@ -59,9 +59,12 @@ def frozen_model(options: ContactOptions, slave: LagrangeSurface,
     else:
         if u_nodes is not None:  # bases and segmentation in the configuration u
             slave, master = slave.moved(u_nodes), master.moved(u_nodes)
+        # the candidates are segmented in equal shares over the ranks: the
+        # graph partition often gives one rank the whole contact zone
         coupling = MortarCoupling(slave, master, keep_points=law.pointwise,
                                   search_radius=options.search_radius,
-                                  interface_normals=True, self_contact=options.self_contact)
+                                  interface_normals=True, self_contact=options.self_contact,
+                                  deal_segmentation=True)
         source = SelfContactGap if options.self_contact else MortarGap
         model = source(coupling, law, None if u_nodes is None else u_vector,
                        boundary_modification=options.boundary_modification)
