@@ -7,15 +7,35 @@
 - Each MPI rank runs its own pytest session: give each its own temporary root.
   pytest prunes old numbered folders under /tmp/pytest-of-<user>; two ranks
   sharing that root can delete each other's files mid-test.
+- On several ranks Python's automatic cycle collector is off and cycles are
+  collected after each test, on every rank at once: collected on one rank
+  alone, a Function's PETSc vector left the ranks in different collectives
+  (dolfinx_mortar/solver/lockstep_gc.py; the 2-rank suite hung in
+  test_hard_cases.py in sid).
 """
 from __future__ import annotations
 
+import gc
 import sys
 import tempfile
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(1, str(Path(__file__).resolve().parents[1] / "demos"))
+
+
+@pytest.fixture(autouse=True)
+def cycles_collected_in_lockstep():
+    """On several ranks: no automatic cycle collection during a test, a
+    collection on every rank after it (see the module)."""
+    from mpi4py import MPI
+    if MPI.COMM_WORLD.size > 1:
+        gc.disable()
+    yield
+    if MPI.COMM_WORLD.size > 1:
+        gc.collect()
 
 
 def pytest_configure(config):

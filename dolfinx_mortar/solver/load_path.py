@@ -26,6 +26,7 @@ from dolfinx_mortar.linalg.linear_solver import (DIRECT_OPTIONS, choose_linear_s
                                                  iterative_options)
 from dolfinx_mortar.linalg.near_nullspace import RigidModes
 from dolfinx_mortar.solver.load_stepping import LoadStepper
+from dolfinx_mortar.solver.lockstep_gc import collect_in_lockstep, lockstep_garbage_collection
 from dolfinx_mortar.solver.newton import (EquilibriumTest, FullStepFirst, PathExtrapolation,
                                           StepNewton)
 from dolfinx_mortar.solver.nonlinear_problem import NonlinearContactProblem, contact_matrix
@@ -204,7 +205,9 @@ class LoadPathSolver:
         path = PathExtrapolation() if predictor == "linear" else None
         self._user_options = {"snes_linesearch_type": PETSc.Options().hasName(
             self.prefix + "snes_linesearch_type")}
-        with self.options():
+        # the cycle collector runs only where every rank is (lockstep_gc: a
+        # Function freed on one rank only deadlocked the next PETSc object)
+        with self.options(), lockstep_garbage_collection(self._comm):
             self._options_checked = False
             snes = self.create_snes()
             newton = StepNewton(self.problem, self._equilibrium, self.line_search,
@@ -222,6 +225,7 @@ class LoadPathSolver:
                  target: float, run: PathRun, path: Optional[PathExtrapolation]) -> None:
         """One attempt at the load step to ``target``: converged and accepted,
         solved again (a wider search radius), or cut back."""
+        collect_in_lockstep(self._comm)
         update(target)
         if any([term.begin_step() for term in self.problem.contacts]):
             # the bases were rebuilt: the contact pattern may have changed
