@@ -223,10 +223,9 @@ class ContactTerm:
         return radius is not None and self._rebuild(radius)
 
     def accept_step(self, state: Optional[ContactState] = None) -> None:
-        """The present u is a converged load step: friction's history (the
-        tangential forces, the step's dissipation) moves on to it, and the slip
-        is checked. A load-path driver calls it once per accepted step, never
-        after a failed one, so that a cut-back retries from the same history."""
+        """The present u is a converged load step: friction's history and the
+        missed-contact check's start move on to it, and the slip is checked.
+        Never called after a failed step: a cut-back retries from the same history."""
         state = state or self.evaluate()
         if self.friction is not None:
             self.friction.accept(state.friction, self.u)
