@@ -26,6 +26,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(1, str(Path(__file__).resolve().parents[1] / "demos"))
 
 
+def pytest_collection_finish(session):
+    """On several ranks: what exists once the tests are collected (modules,
+    the test items) is left out of every later collection (``gc.freeze``), so
+    that the collection after each test reads only what the tests made."""
+    from mpi4py import MPI
+    if MPI.COMM_WORLD.size > 1:
+        gc.collect()
+        gc.freeze()
+
+
 @pytest.fixture(autouse=True)
 def cycles_collected_in_lockstep():
     """On several ranks: no automatic cycle collection during a test, a
