@@ -9,7 +9,7 @@ import numpy.typing as npt
 from mpi4py import MPI
 
 from dolfinx_mortar import _kernels
-from dolfinx_mortar.mortar.surface_exchange import SurfaceCopy, volume_ids
+from dolfinx_mortar.mortar.surface_exchange import SurfaceCopy, facet_extents, volume_ids
 from dolfinx_mortar.mortar.surface_normals import cluster_diameters, swept_facet_boxes
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
@@ -54,7 +54,7 @@ def search_boxes(slave: LagrangeSurface, xs: FloatArray, slave_cells: npt.NDArra
     """
     # each slave facet's diameter (its largest coordinate extent)
     diameters = cluster_diameters(
-        slave, clusters, np.max(np.ptp(xs[slave.cells], axis=1), axis=1, initial=0.0))
+        slave, clusters, facet_extents(slave, xs))
     if search_radius is None:
         search_radius = slave.layout.comm.allreduce(float(np.max(diameters, initial=0.0)),
                                                     op=MPI.MAX)

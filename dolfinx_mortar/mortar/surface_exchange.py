@@ -125,11 +125,16 @@ def meeting(facet_boxes: FloatArray, region: FloatArray) -> npt.NDArray[np.bool_
     return chosen
 
 
+def facet_extents(surface: LagrangeSurface, x: FloatArray) -> FloatArray:
+    """Each local facet's extent, its largest coordinate range, at the node
+    coordinates ``x``: the diameter every search radius is measured in."""
+    return np.max(np.ptp(x[surface.cells], axis=1), axis=1, initial=0.0)
+
+
 def largest_facet(surface: LagrangeSurface, x: FloatArray) -> float:
-    """The largest facet's extent (its largest coordinate range) over all ranks:
+    """The largest facet's extent (:func:`facet_extents`) over all ranks:
     the band that brings every neighbour of a reachable facet along."""
-    cells = surface.cells
-    local = float(np.max(np.ptp(x[cells], axis=1), initial=0.0)) if len(cells) else 0.0
+    local = float(np.max(facet_extents(surface, x), initial=0.0))
     return surface.layout.comm.allreduce(local, op=MPI.MAX)
 
 

@@ -37,6 +37,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.gap_sources import FACET_SEARCH_FACTOR
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.mortar.coupling import MortarCoupling
+from dolfinx_mortar.mortar.surface_exchange import facet_extents
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.tolerance import NEAR_CONTACT
 
@@ -129,8 +130,8 @@ class MissedContact:
         if term.options.search_radius is not None:
             return term.options.search_radius
         slave = term.slave
-        x = slave.x + nodal_displacement(slave, term.u)
-        local = float(np.min(np.max(np.ptp(x[slave.cells], axis=1), axis=1), initial=np.inf))
+        extents = facet_extents(slave, slave.x + nodal_displacement(slave, term.u))
+        local = float(np.min(extents, initial=np.inf))
         return FACET_SEARCH_FACTOR * term.comm.allreduce(local, op=MPI.MIN)
 
     def wider_radius(self, state: ContactState) -> Optional[float]:
