@@ -141,17 +141,13 @@ def condition(A, free: Optional[np.ndarray] = None) -> float:
 
 def slave_values(problem, values: np.ndarray) -> np.ndarray:
     """Owned values at the slave surface's nodes, gathered on every rank."""
-    n = problem.slave.layout.num_owned
-    on = np.zeros(problem.slave.layout.size_local, dtype=bool)
-    on[problem.slave.cells] = True
-    return np.concatenate(problem.mesh.comm.allgather(values[:n][on[:n]]))
+    mine = problem.slave.layout.owned_on_cells(problem.slave.cells)
+    return np.concatenate(problem.mesh.comm.allgather(values[mine]))
 
 
 def slave_coordinates(problem) -> np.ndarray:
-    n = problem.slave.layout.num_owned
-    on = np.zeros(problem.slave.layout.size_local, dtype=bool)
-    on[problem.slave.cells] = True
-    return np.concatenate(problem.mesh.comm.allgather(problem.slave.x[:n][on[:n]]))
+    mine = problem.slave.layout.owned_on_cells(problem.slave.cells)
+    return np.concatenate(problem.mesh.comm.allgather(problem.slave.x[mine]))
 
 
 def contact_force(problem) -> float:

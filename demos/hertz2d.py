@@ -73,13 +73,9 @@ def contact_results(problem, ref: dict) -> dict:
     and the L2 error."""
     comm = problem.mesh.comm
     slave = problem.slave
-    n = slave.layout.num_owned
     p = problem.nodal_pressures()
-    on_slave = np.zeros(slave.layout.size_local, dtype=bool)
-    on_slave[slave.cells] = True
-    mine = on_slave[:n]
-    xs = np.concatenate(comm.allgather(slave.x[:n, 0][mine]))
-    ps = np.concatenate(comm.allgather(p[:n][mine]))
+    surface = problem.surface_pressure(gather=True)
+    xs, ps = surface.x[:, 0], surface.p
     fit = fit_hertz_profile(xs, ps, ref["a"])
     p0, a_fit = fit.p0, fit.a
     # L2 error of p̂ = Σ N_A p_A over [0, a_Hertz] on the slave quadrature points

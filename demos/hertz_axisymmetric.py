@@ -76,13 +76,9 @@ def contact_results(problem, ref: dict, radius: float) -> dict:
     and the L2 error of the pressure over the swept contact zone."""
     comm = problem.mesh.comm
     slave = problem.slave
-    n = slave.layout.num_owned
     p = problem.nodal_pressures()
-    on_slave = np.zeros(slave.layout.size_local, dtype=bool)
-    on_slave[slave.cells] = True
-    mine = on_slave[:n]
-    rs = np.concatenate(comm.allgather(slave.x[:n, 0][mine]))
-    ps = np.concatenate(comm.allgather(p[:n][mine]))
+    surface = problem.surface_pressure(gather=True)
+    rs, ps = surface.x[:, 0], surface.p
     fit = fit_hertz_profile(rs, ps, ref["a"])
     p0, a_fit = fit.p0, fit.a
     # L2 error of p̂ = Σ N_A p_A over r < 1.5 a, weighted by the swept area 2πr ds

@@ -113,11 +113,8 @@ def run(args, orientation: str, kind: str, scaling: str, comm=MPI.COMM_WORLD) ->
                              quadratic_transform=(args.degree == 2 and d == 3))
     result = problem.solve(load_steps=1)
     state = problem.contact.evaluate()
-    p = problem.contact.results.nodal_pressures(state)
     n = problem.slave.layout.num_owned
-    on = np.zeros(problem.slave.layout.size_local, dtype=bool)
-    on[problem.slave.cells] = True
-    values = np.concatenate(comm.allgather(p[:n][on[:n]]))
+    values = problem.surface_pressure(state, gather=True).p
     # the uniform pressure that carries the applied force over the slave surface
     # the bases live on (the unit face, or in the current configuration the
     # face stretched sideways by the Poisson effect)

@@ -74,6 +74,15 @@ class NodeLayout:
         """
         return self.sum_at_functions(cells, np.ones(np.shape(cells))) > 0.5
 
+    def owned_on_cells(self, cells: IntArray) -> IntArray:
+        """The owned functions that belong to one of ``cells`` on any rank (collective).
+
+        Not the owned entries of ``np.unique(cells)``: a node can be owned by a rank
+        that holds none of its surface cells (its bulk cells only), and such a node
+        was left out of the GLS Newton system on 8 ranks.
+        """
+        return np.flatnonzero(self.on_cells(cells)[: self.num_owned])
+
     def sum_at_functions(self, cells: IntArray, element_values: FloatArray) -> FloatArray:
         """Σ over all elements on all ranks of element values at each local function.
 

@@ -33,12 +33,8 @@ def reaction(problem: ContactProblem, tag: int, component: int) -> float:
 
 def slave_pressures(problem: ContactProblem) -> np.ndarray:
     """(x, p) of the owned slave nodes on all ranks, sorted by x."""
-    layout = problem.slave.layout
-    on = np.zeros(layout.size_local, dtype=bool)
-    on[problem.slave.cells] = True
-    on[layout.num_owned:] = False
-    local = np.column_stack([problem.slave.x[on, 0], problem.nodal_pressures()[on]])
-    values = np.vstack(problem.mesh.comm.allgather(local))
+    surface = problem.surface_pressure(gather=True)
+    values = np.column_stack([surface.x[:, 0], surface.p])
     return values[np.argsort(values[:, 0], kind="stable")]
 
 

@@ -217,13 +217,8 @@ def two_mesh_problem(comm, kind, separate=True, shear=0.0):
 
 def slave_pressures(problem):
     """(x, p) of the owned slave nodes of all ranks, sorted by x."""
-    comm = problem.mesh.comm
-    n = problem.slave.layout.num_owned
-    on = np.zeros(problem.slave.layout.size_local, dtype=bool)
-    on[problem.slave.cells] = True  # the surface's nodes are all the mesh's nodes
-    on[n:] = False
-    local = np.column_stack([problem.slave.x[on, 0], problem.nodal_pressures()[on]])
-    values = np.vstack(comm.allgather(local))
+    surface = problem.surface_pressure(gather=True)
+    values = np.column_stack([surface.x[:, 0], surface.p])
     return values[np.argsort(values[:, 0])]
 
 

@@ -65,8 +65,7 @@ class GlobalGap:
         self.dofs = inner.dofs
         self.covered = inner.covered
         #: owned local nodes of the slave surface (the rows the Newton step needs)
-        owned = np.unique(self.slave.cells)
-        self.surface_rows = owned[owned < self.slave.layout.num_owned]
+        self.surface_rows = self.slave.layout.owned_on_cells(self.slave.cells)
         # Π_c = Σ (ω_A/2)⟨d̄_A⟩² in terms of the GLS gap d̄ (∫M_A = 1)
         self.weights = np.where(self.covered, law.weights(W), 0.0)
 
