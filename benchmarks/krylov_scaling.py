@@ -2,7 +2,7 @@
 against mesh size and penalty, time and memory against MUMPS.
 
 Runs the scene of ``demos/hertz3d.py --obstacle elastic`` (sphere octant on
-an elastic block, LcLS*, nodal active set, 3 load steps) for every mesh level
+an elastic block, LcLS*, nodal active set, 3 load steps or ``--load-steps``) for every mesh level
 × penalty × linear solver given, in this process, and tabulates per run: dofs,
 Newton iterations, Krylov iterations per Newton iteration, wall time of the
 whole solve and its parts (contact, bulk assembly, the rest = linear solves),
@@ -76,12 +76,15 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         help="ε as multiples of E/h")
     parser.add_argument("--solvers", nargs="+", default=["block", "gamg", "direct"],
                         choices=sorted(SOLVERS))
+    parser.add_argument("--load-steps", type=int, default=None,
+                        help="load steps (the demo's default, 3)")
     parser.add_argument("--tag", default="", help="suffix of the result files")
     parser.add_argument("--out", default=str(HERE / "results"))
     return parser.parse_args(argv)
 
 
-def run_one(demo, solver: str, refine: float, penalty: float) -> dict:
+def run_one(demo, solver: str, refine: float, penalty: float,
+            load_steps: Optional[int] = None) -> dict:
     """One solve of the scene; its row of the table (on every rank)."""
     comm = MPI.COMM_WORLD
     linear_solver, options = SOLVERS[solver]
@@ -90,7 +93,8 @@ def run_one(demo, solver: str, refine: float, penalty: float) -> dict:
         db[PREFIX + key] = value
     try:
         args = demo.parse_args(["--obstacle", "elastic", "--refine", str(refine),
-                                "--penalty", str(penalty), "--linear-solver", linear_solver])
+                                "--penalty", str(penalty), "--linear-solver", linear_solver]
+                               + ([] if load_steps is None else ["--load-steps", str(load_steps)]))
         comm.Barrier()
         clock = time.perf_counter()
         problem, context = demo.build_problem(args, comm)
@@ -120,8 +124,9 @@ def run_one(demo, solver: str, refine: float, penalty: float) -> dict:
             "a_error": figures["a_error"], "l2_error": figures["l2_error"]}
 
 
-def markdown(rows: list[dict], load: float) -> str:
-    lines = [f"Hertz 3D, sphere octant on an elastic block (LcLS*, nodal, 3 load steps), "
+def markdown(rows: list[dict], load: float, load_steps: int) -> str:
+    lines = [f"Hertz 3D, sphere octant on an elastic block (LcLS*, nodal, {load_steps} load "
+             f"step{'s' if load_steps > 1 else ''}), "
              f"{MPI.COMM_WORLD.size} rank(s); 1-minute load average before the run "
              f"{load:.2f} on {os.cpu_count()} cores. Times in s; memory is the peak "
              "resident size of the process(es) so far, summed over ranks.", "",
@@ -150,31 +155,37 @@ def main(argv: Optional[Sequence[str]] = None) -> list[dict]:
         for penalty in args.penalties:
             for solver in args.solvers:
                 try:
-                    rows.append(run_one(demo, solver, refine, penalty))
+                    rows.append(run_one(demo, solver, refine, penalty, args.load_steps))
                 except Exception as error:  # a solver that fails is a result too
                     if comm.rank == 0:
                         print(f"{solver} refine {refine:g} ε {penalty:.0e}: FAILED: "
                               f"{str(error).splitlines()[0]}", flush=True)
                     continue
                 if comm.rank == 0:
-                    write_results(rows, args, load)  # after each run: a long study
+                    write_results(rows, args, load, load_steps_of(args, demo))  # a long study
                     r = rows[-1]
                     print(f"{solver} refine {refine:g} ε {penalty:.0e}: {r['dofs']} dofs, "
                           f"Newton {r['newton']}, Krylov/Newton {r['krylov_per_newton']:.1f}, "
                           f"{r['wall_time']:.1f} s", flush=True)
                 gc.collect()
     if comm.rank == 0:
-        print(markdown(rows, load))
+        print(markdown(rows, load, load_steps_of(args, demo)))
     return rows
 
 
-def write_results(rows: list[dict], args: argparse.Namespace, load: float) -> None:
+def load_steps_of(args: argparse.Namespace, demo) -> int:
+    """The load steps of the runs: ``--load-steps``, or the demo's default."""
+    return args.load_steps or demo.parse_args([]).load_steps
+
+
+def write_results(rows: list[dict], args: argparse.Namespace, load: float,
+                  load_steps: int) -> None:
     """The table so far as CSV and markdown (atomically: an interrupted study
     leaves the rows it finished)."""
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     stem = "krylov_scaling" + (f"_{args.tag}" if args.tag else "")
-    table = markdown(rows, load)
+    table = markdown(rows, load, load_steps)
     write_csv(out / f"{stem}.csv", rows, COLUMNS)
     write_atomically(out / f"{stem}.md", lambda tmp: Path(tmp).write_text(table))
 
