@@ -105,8 +105,10 @@ def test_nodal_pressures_agree_on_one_and_all_ranks(case, kind):
         local_cells.append(len(surface.cells))
         values = MortarBasis(kind, surface).nodal_values(pressure_any_dim)
         results.append(owned_by_coordinates(V, values))
-    # every rank must own slave facets, or the ghost exchange went untested
-    assert min(comm.allgather(local_cells[0])) > 0
+    # two ranks at least must hold slave facets, or the ghost exchange went untested (on
+    # 3 ranks the partition may leave one rank without any: it then holds 0 of them)
+    holding = sum(count > 0 for count in comm.allgather(local_cells[0]))
+    assert holding >= min(comm.size, 2), holding
     (x_par, v_par), (x_ser, v_ser) = results
     assert len(x_par) == len(x_ser)
     distance, index = cKDTree(x_ser).query(x_par)
