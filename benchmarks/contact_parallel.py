@@ -79,7 +79,7 @@ def rank_row(problem, result, wall: float) -> dict:
     row = {"rank": problem.mesh.comm.rank,
            "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
            "newton": result.newton_iterations, "krylov": result.linear_iterations,
-           "owned_slave_nodes": len(problem.slave.layout.owned_on_cells(problem.slave.cells)),
+           "owned_slave_nodes": len(problem.slave.owned_nodes),
            "slave_facets": len(problem.slave.cells),
            "candidates": getattr(coupling, "num_candidates", 0),
            "pairs": len(coupling.pairs) if coupling is not None else 0,

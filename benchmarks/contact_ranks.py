@@ -241,7 +241,7 @@ def ironing3d(args: argparse.Namespace, comm) -> dict:
     t = dict(problem.timings)
     t.update({f"contact_{k}": v for k, v in term.timings.items()})
     row = {"rank": comm.rank, "dofs": figures["dofs"], "newton": figures["newton_iterations"],
-           "krylov": 0, "owned_slave_nodes": len(slave.layout.owned_on_cells(slave.cells)),
+           "krylov": 0, "owned_slave_nodes": len(slave.owned_nodes),
            "slave_facets": len(slave.cells), "master_facets": len(last.master_copy.cells),
            "candidates": last.num_candidates, "pairs": len(last.pairs),
            "setup": t.get("contact_setup", 0.0), "setup_rest": 0.0,

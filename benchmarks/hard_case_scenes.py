@@ -141,12 +141,12 @@ def condition(A, free: Optional[np.ndarray] = None) -> float:
 
 def slave_values(problem, values: np.ndarray) -> np.ndarray:
     """Owned values at the slave surface's nodes, gathered on every rank."""
-    mine = problem.slave.layout.owned_on_cells(problem.slave.cells)
+    mine = problem.slave.owned_nodes
     return np.concatenate(problem.mesh.comm.allgather(values[mine]))
 
 
 def slave_coordinates(problem) -> np.ndarray:
-    mine = problem.slave.layout.owned_on_cells(problem.slave.cells)
+    mine = problem.slave.owned_nodes
     return np.concatenate(problem.mesh.comm.allgather(problem.slave.x[mine]))
 
 

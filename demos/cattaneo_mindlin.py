@@ -230,7 +230,7 @@ def results(args: argparse.Namespace, contact, ref: dict) -> dict:
     slave = contact.slave
     sphere = args.geometry == "sphere"
     state = contact.evaluate()
-    mine = slave.layout.owned_on_cells(slave.cells)
+    mine = slave.owned_nodes
     # distance from the centre of contact in the contact plane
     r = np.linalg.norm(slave.x[:, :2], axis=1) if sphere else slave.x[:, 0]
     x = np.concatenate(comm.allgather(r[mine]))

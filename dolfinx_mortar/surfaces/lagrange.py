@@ -296,6 +296,13 @@ class LagrangeSurface:
                                              self.cells.astype(np.int32))
 
     @cached_property
+    def owned_nodes(self) -> npt.NDArray[np.int64]:
+        """The local nodes this rank owns on any rank's cells of this surface
+        (:meth:`NodeLayout.owned_on_cells`; collective on first use, then kept:
+        the friction Jacobian asks for them at every Newton iteration)."""
+        return self.layout.owned_on_cells(self.cells)
+
+    @cached_property
     def zero_length(self) -> float:
         """Lengths at or below this are zero on this surface: the geometric
         tolerance times its length scale over every rank (collective on first

@@ -144,7 +144,7 @@ def test_one_mesh_with_two_bodies():
         n = slave.layout.num_owned
         xs = V.tabulate_dof_coordinates()[:n]
         on_slave = np.zeros(n, dtype=bool)
-        on_slave[slave.layout.owned_on_cells(slave.cells)] = True
+        on_slave[slave.owned_nodes] = True
         # nodes whose whole support is covered (the master starts at x = 0.2, h = 0.1)
         inside = on_slave & (xs[:, 0] > 0.2 + 0.1 + 1e-12)
         assert np.max(np.abs(us.array[inside] - (1 + 2 * xs[inside, 0])), initial=0) < 1e-12

@@ -67,7 +67,7 @@ def test_slave_nodes_owned_where_none_of_their_facets_are(kind):
         slave = problem.slave
         owned = slave.layout.num_owned
         held = np.unique(slave.cells)
-        apart = np.setdiff1d(slave.layout.owned_on_cells(slave.cells), held[held < owned])
+        apart = np.setdiff1d(slave.owned_nodes, held[held < owned])
         problem.solve(load_steps=2)
         results.append((comm.allreduce(len(apart)), problem.surface_pressure(gather=True),
                         problem.contact_force()))

@@ -63,7 +63,7 @@ def body_penetration(term) -> tuple[float, float, list]:
     # where the obstacle started (a moved obstacle is a translated one)
     start = np.asarray(getattr(obstacle, "displacement", np.zeros(gdim)))
     outside = obstacle.signed_distance(X + start) >= -zero_length(length_scale(X, comm))
-    outside[term.slave.layout.owned_on_cells(term.slave.cells)] = False  # u's nodes
+    outside[term.slave.owned_nodes] = False  # u's nodes
     depth = np.where(outside, -obstacle.signed_distance(X + u), -np.inf)
     # each node's length: the largest diameter of its cells (of their nodes' spread)
     dofs = V.dofmap.list

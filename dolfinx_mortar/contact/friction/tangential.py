@@ -180,7 +180,7 @@ class Friction:
         on the dofs (``columns="dofs"``) or (gdim × 1) on the node
         (``columns="nodes"``)."""
         layout, gdim, dofs_layout = self.slave.layout, self.slave.gdim, source.dofs
-        nodes = layout.owned_on_cells(self.slave.cells)
+        nodes = self.slave.owned_nodes
         rows = nodes[:, None] * gdim + np.arange(gdim)
         if columns == "dofs":
             dofs = layout.global_indices[nodes][:, None] * gdim + np.arange(gdim)

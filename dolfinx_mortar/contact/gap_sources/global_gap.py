@@ -65,7 +65,7 @@ class GlobalGap:
         self.dofs = inner.dofs
         self.covered = inner.covered
         #: owned local nodes of the slave surface (the rows the Newton step needs)
-        self.surface_rows = self.slave.layout.owned_on_cells(self.slave.cells)
+        self.surface_rows = self.slave.owned_nodes
         # Π_c = Σ (ω_A/2)⟨d̄_A⟩² in terms of the GLS gap d̄ (∫M_A = 1)
         self.weights = np.where(self.covered, law.weights(W), 0.0)
 

@@ -34,7 +34,7 @@ def at_surface_nodes(term, gather: bool, *values: np.ndarray) -> tuple:
     """
     slave = term.slave
     layout = slave.layout
-    nodes = layout.owned_on_cells(slave.cells)
+    nodes = slave.owned_nodes
     part = (slave.x[nodes], [v[nodes] for v in values], layout.global_indices[nodes])
     if not gather:
         return (part[0], *part[1], part[2])
@@ -65,6 +65,6 @@ def slave_resultant(term, residual: PETSc.Vec) -> FloatArray:
     """
     gdim = term.slave.gdim
     R = residual.array_r.reshape(-1, gdim)
-    nodes = term.slave.layout.owned_on_cells(term.slave.cells)
+    nodes = term.slave.owned_nodes
     local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
     return np.asarray(term.comm.allreduce(local))
