@@ -38,13 +38,16 @@ DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 # libopenblas0-serial replaces the reference BLAS behind PETSc/MUMPS: 3.7x faster
 # factorizations on Hertz 3D (33 s -> 8.8 s), serial so it does not fight MPI ranks.
 
-# A second CPU's round-off: the serial suite runs again with OpenBLAS's kernels
-# for another core type, so a test that depends on which side of zero
-# round-off lands fails here rather than on a user's machine (a zero-length
-# cell measures 5.6e-17 with SkylakeX kernels and 0 with Haswell's).
+# A second CPU's round-off: make test's run on 2 MPI ranks uses OpenBLAS's kernels
+# for another core type, so a test that depends on which side of zero round-off
+# lands fails there rather than on a user's machine (a zero-length cell measures
+# 5.6e-17 with SkylakeX kernels and 0 with Haswell's); the serial run keeps the
+# host's. (Until 2026-12-06 the serial suite ran a third time for it: 11-12 min
+# a suite, which left CI no time for one retried oversubscribed step.)
 # Empty: tools/second_coretype.py picks Haswell, or Sandybridge where Haswell's
 # kernels crash NumPy itself (OpenBLAS 0.3.34 on AVX-512 AMD hosts).
 SECOND_CORETYPE ?=
+CORETYPE = $(or $(SECOND_CORETYPE),$$($(PYTHON) tools/second_coretype.py))
 
 # make shell-SUITE: the Debian root $(DEBIAN_ROOTS)/$(DEV_ROOT)-SUITE (tools/debian-root)
 DEBIAN_ROOTS ?= $(or $(DOLFINX_MORTAR_ROOTS),/var/tmp/dolfinx_mortar-roots)
@@ -53,7 +56,7 @@ DEV_ROOT ?= dev
 # The targets run one after the other even under make -j (the builds inside use $(JOBS) jobs).
 .NOTPARALLEL:
 
-.PHONY: help setup deps venv build-cpp demo test test-cpp test-python test-mpi test-coretype \
+.PHONY: help setup deps venv build-cpp demo test test-cpp test-python test-mpi test-mpi-coretype test-coretype \
 	test-paraview test-ranks \
 	bench bench-speed bench-scale stress shell-trixie shell-sid clean
 
@@ -61,10 +64,12 @@ help:
 	@echo "make setup  - install missing Debian packages, make the virtual environment .venv (it sees"
 	@echo "              Debian's DOLFINx) and install dolfinx_mortar into it: pip builds the kernels"
 	@echo "make demo   - setup, then the main demo (Hertz 2D, figures 1 and 2) into results/"
-	@echo "make test   - setup, then C++ tests (ctest), pytest, pytest under mpirun -n 2, a few"
-	@echo "              tests on 3 and 4 ranks, and pytest again with another CPU's BLAS kernels"
+	@echo "make test   - setup, then C++ tests (ctest), pytest, pytest under mpirun -n 2 with"
+	@echo "              another CPU's BLAS kernels, a few tests on 3 and 4 ranks, ParaView"
 	@echo "make test-cpp    - build the C++ kernels and their GoogleTest tests in build/, run ctest"
-	@echo "make test-python / test-mpi / test-ranks / test-coretype - one of the pytest runs of make test"
+	@echo "make test-python / test-mpi-coretype / test-ranks - one of the pytest runs of make test"
+	@echo "make test-mpi, make test-coretype - pytest on 2 ranks with the host's BLAS kernels, and"
+	@echo "              serial pytest with another CPU's (by hand; make test runs neither)"
 	@echo "make test-paraview - ParaView (pvpython, installed if missing) opens a series the library"
 	@echo "              writes and reads its last step as written (tools/paraview_check.py)"
 	@echo "make bench  - setup, then the benchmarks in benchmarks/ (speed vs error: --quick)"
@@ -119,7 +124,7 @@ demo: setup
 	$(PYTHON) demos/fig1_bases.py --json results/fig1_bases.json
 	$(PYTHON) demos/fig2_sphere_nurbs.py --json results/fig2_pressures.json
 
-test: setup test-cpp test-python test-mpi test-ranks test-coretype test-paraview
+test: setup test-cpp test-python test-mpi-coretype test-ranks test-paraview
 
 test-cpp: build-cpp
 	cd $(BUILD_DIR) && ctest --output-on-failure
@@ -129,6 +134,11 @@ test-python:
 
 test-mpi:
 	$(MPIRUN) $(PYTEST) -p no:cacheprovider tests
+
+test-mpi-coretype:
+	@coretype=$(CORETYPE) && \
+	echo "OPENBLAS_CORETYPE=$$coretype $(MPIRUN) $(PYTEST) -p no:cacheprovider tests" && \
+	OPENBLAS_CORETYPE=$$coretype $(MPIRUN) $(PYTEST) -p no:cacheprovider tests
 
 # More ranks than cores (tools/oversubscribed: correct, not fast; Open MPI yields while a rank
 # waits; a run past its time is started once more, saying so): the surface exchange's invariants
@@ -144,13 +154,15 @@ RANKS_TESTS_3 = tests/mortar/test_surface_exchange.py tests/mortar/test_mortar_p
 RANKS_TESTS_4 = tests/contact/test_mirror.py tests/solver/test_problem.py::test_patch_test_passes_with_the_consistent_scaling \
 	tests/solver/test_two_meshes.py::test_patch_test_on_two_meshes_matches_one_mesh \
 	tests/contact/test_friction_scenes.py tests/contact/test_self_contact_friction.py
+# faulthandler_timeout: a test stuck for 150 s prints every rank's Python stack (which
+# collective each waits in) before the step's timeout stops it.
 test-ranks:
-	tools/oversubscribed 3 300 $(PYTEST) -p no:cacheprovider $(RANKS_TESTS_3)
-	tools/oversubscribed 4 400 $(PYTEST) -p no:cacheprovider \
+	tools/oversubscribed 3 300 $(PYTEST) -p no:cacheprovider -o faulthandler_timeout=150 $(RANKS_TESTS_3)
+	tools/oversubscribed 4 400 $(PYTEST) -p no:cacheprovider -o faulthandler_timeout=150 \
 		-k "not pointwise and not under_refinement and not spheres_in_3d" $(RANKS_TESTS_4)
 
 test-coretype:
-	@coretype=$(or $(SECOND_CORETYPE),$$($(PYTHON) tools/second_coretype.py)) && \
+	@coretype=$(CORETYPE) && \
 	echo "OPENBLAS_CORETYPE=$$coretype $(PYTEST) -p no:cacheprovider tests" && \
 	OPENBLAS_CORETYPE=$$coretype $(PYTEST) -p no:cacheprovider tests
 

@@ -1,6 +1,6 @@
-"""Print the OpenBLAS core type whose kernels the second serial test run uses.
+"""Print the OpenBLAS core type whose kernels make test's 2-rank test run uses.
 
-The second run exists to see another CPU's round-off, so its core type must differ from the
+That run uses it to see another CPU's round-off, so its core type must differ from the
 host's and must itself work. Haswell's kernels (AVX2 with FMA) are the first choice. OpenBLAS
 0.3.34 (Debian sid) enlarges the GEMM blocking on AMD Zen 4/5 hosts that expose AVX-512 even
 when another core type is forced, and ``dgemm_kernel_HASWELL`` then overruns its stack
