@@ -142,8 +142,9 @@ test-mpi-coretype:
 
 # More ranks than cores (tools/oversubscribed: correct, not fast; Open MPI yields while a rank
 # waits; a run past its time is started once more, saying so): the surface exchange's invariants
-# on 3 ranks (6 s), and the mirror, patch and friction tests on 4 (without the slowest: the
-# pointwise mirrors and the refinement study; 65-75 s alone on 2 cores). Nor the 3D sphere
+# on 3 ranks (10 s), and the mirror, patch and friction tests on 4 (without the slowest: the
+# pointwise mirrors and the refinement study; 80-85 s alone on 2 cores). The timeouts leave
+# 3x the usual time or more, and a retried 4-rank step costs CI at most 15 min. Nor the 3D sphere
 # mirrors: on 4 ranks sid's Open MPI 6.0.0rc2 spun in sched_yield for minutes three times in
 # them (tests 44-49 of the step; CI timed out at 20 min); they run on 1 and 2 ranks. A deadlock
 # that looks the same (ranks in different collectives, spinning in sched_yield) was later found
@@ -154,11 +155,11 @@ RANKS_TESTS_3 = tests/mortar/test_surface_exchange.py tests/mortar/test_mortar_p
 RANKS_TESTS_4 = tests/contact/test_mirror.py tests/solver/test_problem.py::test_patch_test_passes_with_the_consistent_scaling \
 	tests/solver/test_two_meshes.py::test_patch_test_on_two_meshes_matches_one_mesh \
 	tests/contact/test_friction_scenes.py tests/contact/test_self_contact_friction.py
-# faulthandler_timeout: a test stuck for 150 s prints every rank's Python stack (which
+# faulthandler_timeout: a test stuck that long prints every rank's Python stack (which
 # collective each waits in) before the step's timeout stops it.
 test-ranks:
-	tools/oversubscribed 3 300 $(PYTEST) -p no:cacheprovider -o faulthandler_timeout=150 $(RANKS_TESTS_3)
-	tools/oversubscribed 4 400 $(PYTEST) -p no:cacheprovider -o faulthandler_timeout=150 \
+	tools/oversubscribed 3 120 $(PYTEST) -p no:cacheprovider -o faulthandler_timeout=100 $(RANKS_TESTS_3)
+	tools/oversubscribed 4 300 $(PYTEST) -p no:cacheprovider -o faulthandler_timeout=150 \
 		-k "not pointwise and not under_refinement and not spheres_in_3d" $(RANKS_TESTS_4)
 
 test-coretype:
