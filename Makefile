@@ -31,7 +31,7 @@ PYTEST = $(PYTHON_ABS) -P -m pytest -q --color=no
 
 DEB_PACKAGES := python3-dolfinx libdolfinx-dev python3-basix python3-ufl \
 	python3-ffcx python3-petsc4py python3-mpi4py python3-gmsh pybind11-dev \
-	libeigen3-dev python3-pytest python3-matplotlib python3-scipy python3-tqdm \
+	libeigen3-dev python3-pytest python3-pytest-xdist python3-matplotlib python3-scipy python3-tqdm \
 	python3-dev cmake g++ make libgtest-dev openmpi-bin libopenblas0-serial python3-h5py \
 	python3-scikit-build-core python3-pip python3-venv ninja-build python3-lxml
 # python3-lxml: the tests resolve the XDMF series' XIncludes with libxml2, as ParaView does.
@@ -129,8 +129,11 @@ test: setup test-cpp test-python test-mpi-coretype test-ranks test-paraview
 test-cpp: build-cpp
 	cd $(BUILD_DIR) && ctest --output-on-failure
 
+# The serial suite on $(JOBS) cores: pytest-xdist's workers, each file's tests in one worker
+# (its module fixtures stay in one process). PYTHONSAFEPATH: the workers keep the checkout off
+# their path too, as -P does here (its package has no compiled kernels).
 test-python:
-	$(PYTEST) tests
+	PYTHONSAFEPATH=1 $(PYTEST) -n $(JOBS) --dist loadfile tests
 
 test-mpi:
 	$(MPIRUN) $(PYTEST) -p no:cacheprovider tests
