@@ -138,10 +138,10 @@ test-python:
 test-mpi:
 	$(MPIRUN) $(PYTEST) -p no:cacheprovider tests
 
+# test-mpi and test-python again with the second core type's kernels (a failed choice stops it)
 test-mpi-coretype:
-	@coretype=$(CORETYPE) && \
-	echo "OPENBLAS_CORETYPE=$$coretype $(MPIRUN) $(PYTEST) -p no:cacheprovider tests" && \
-	OPENBLAS_CORETYPE=$$coretype $(MPIRUN) $(PYTEST) -p no:cacheprovider tests
+	@coretype=$(CORETYPE) && echo "OPENBLAS_CORETYPE=$$coretype" && \
+	OPENBLAS_CORETYPE=$$coretype $(MAKE) --no-print-directory test-mpi
 
 # More ranks than cores (tools/oversubscribed: correct, not fast; Open MPI yields while a rank
 # waits; a run past its time is started once more, saying so): the surface exchange's invariants
@@ -166,9 +166,8 @@ test-ranks:
 		-k "not pointwise and not under_refinement and not spheres_in_3d" $(RANKS_TESTS_4)
 
 test-coretype:
-	@coretype=$(CORETYPE) && \
-	echo "OPENBLAS_CORETYPE=$$coretype $(PYTEST) -p no:cacheprovider tests" && \
-	OPENBLAS_CORETYPE=$$coretype $(PYTEST) -p no:cacheprovider tests
+	@coretype=$(CORETYPE) && echo "OPENBLAS_CORETYPE=$$coretype" && \
+	OPENBLAS_CORETYPE=$$coretype $(MAKE) --no-print-directory test-python
 
 # ParaView (Debian's paraview, ~1.2 GB with its dependencies; installed here if missing) opens
 # the series of a solve: every field of the last step as the files hold it. Xvfb gives it the
