@@ -149,10 +149,11 @@ test-mpi-coretype:
 # pointwise mirrors and the refinement study; 80-85 s alone on 2 cores). The timeouts leave
 # 3x the usual time or more, and a retried 4-rank step costs CI at most 15 min. Nor the 3D sphere
 # mirrors: on 4 ranks sid's Open MPI 6.0.0rc2 spun in sched_yield for minutes three times in
-# them (tests 44-49 of the step; CI timed out at 20 min); they run on 1 and 2 ranks. A deadlock
-# that looks the same (ranks in different collectives, spinning in sched_yield) was later found
-# and fixed in the 2-rank suite: Python's cycle collector freeing a Function on one rank only
-# (dolfinx_mortar/solver/lockstep_gc.py); whether it was the cause here is not known.
+# them (tests 44-49 of the step; CI timed out at 20 min); they run on 1 and 2 ranks. Two
+# deadlocks that look the same (ranks in different collectives) were later found and fixed:
+# Python's cycle collector freeing a Function on one rank only (solver/lockstep_gc.py), and
+# PT-Scotch 7's own threads in a mesh merge's partition, which stopped CI on 2026-12-06 in the
+# rz sphere mirrors (docs/DOLFINX_VERSIONS.md; tools/oversubscribed sets one thread).
 RANKS_TESTS_3 = tests/mortar/test_surface_exchange.py tests/mortar/test_mortar_parallel.py \
 	tests/contact/test_self_contact_friction.py tests/contact/test_many_bodies.py
 RANKS_TESTS_4 = tests/contact/test_mirror.py tests/solver/test_problem.py::test_patch_test_passes_with_the_consistent_scaling \

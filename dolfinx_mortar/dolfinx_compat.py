@@ -18,6 +18,8 @@ geometry dofmap, coordinate element     ``dofmap``, ``cmap``   ``dofmaps[0]``, `
 """
 from __future__ import annotations
 
+import contextlib
+import os
 from typing import Callable, Optional
 
 import dolfinx
@@ -61,7 +63,8 @@ def model_to_mesh(model, comm: MPI.Comm, rank: int = 0, gdim: int = 3,
     kwargs = {"gdim": gdim}
     if partitioner is not None:
         kwargs["partitioner"] = partitioner
-    result = gmsh_module().model_to_mesh(model, comm, rank, **kwargs)
+    with _scotch_without_threads():
+        result = gmsh_module().model_to_mesh(model, comm, rank, **kwargs)
     if hasattr(result, "mesh"):          # 0.10+: a MeshData
         return result.mesh, result.cell_tags, result.facet_tags
     return tuple(result)[:3]
@@ -71,7 +74,25 @@ def create_mesh(comm: MPI.Comm, cells: npt.NDArray[np.int64], x: npt.NDArray[np.
                 element, partitioner: Optional[Callable] = None) -> dolfinx.mesh.Mesh:
     """``dolfinx.mesh.create_mesh``; the keywords keep the argument order of
     0.9 (cells, x, e) and 0.10+ (cells, e, x) apart."""
-    return dolfinx.mesh.create_mesh(comm, cells, x=x, e=element, partitioner=partitioner)
+    with _scotch_without_threads():
+        return dolfinx.mesh.create_mesh(comm, cells, x=x, e=element, partitioner=partitioner)
+
+
+@contextlib.contextmanager
+def _scotch_without_threads():
+    """PT-Scotch 7 partitions with threads that call MPI collectives of their own; on
+    Debian sid (Scotch 7.0.16, Open MPI 6.0.0rc2) those hung for good in a loop of
+    merges on 4 ranks on 2 cores (tools/scotch_thread_hang.py). One
+    thread per rank (``SCOTCH_PTHREAD_NUMBER``, read at each partition) unless the
+    user chose a number."""
+    chosen = os.environ.get("SCOTCH_PTHREAD_NUMBER")
+    if chosen is None:
+        os.environ["SCOTCH_PTHREAD_NUMBER"] = "1"
+    try:
+        yield
+    finally:
+        if chosen is None:
+            os.environ.pop("SCOTCH_PTHREAD_NUMBER", None)
 
 
 def _takes_max_links(function) -> bool:

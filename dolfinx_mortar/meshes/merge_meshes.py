@@ -75,9 +75,15 @@ def _owned_tagged_facets(domain, facet_tags):
     return nodes, np.asarray(facet_tags.values[owned], dtype=np.int32)
 
 
-def _adjacency(entities: npt.NDArray) -> object:
-    """Rows of entity vertices as the adjacency list ``meshtags_from_entities`` takes."""
-    entities = np.asarray(entities, dtype=np.int32).reshape(len(entities), -1)
+def _adjacency(domain, dim: int, entities: npt.NDArray) -> object:
+    """Rows of entity vertices as the adjacency list ``meshtags_from_entities`` takes.
+
+    The row width comes from the entity type, not from ``entities``: a rank that
+    holds none of the tagged entities gets an empty array without a second axis."""
+    from dolfinx import cpp
+    entity_type = cpp.mesh.cell_entity_type(domain.topology.cell_type, dim, 0)
+    width = cpp.mesh.cell_num_entities(entity_type, 0)
+    entities = np.asarray(entities, dtype=np.int32).reshape(-1, width)
     offsets = np.arange(len(entities) + 1, dtype=np.int32) * entities.shape[1]
     return dolfinx_compat.adjacency_list(entities.ravel(), offsets)
 
@@ -224,7 +230,7 @@ def merge_bodies(meshes: Sequence, facet_tags: Sequence, comm: Optional[MPI.Comm
                            for k, (_, _, cells_k) in enumerate(data)])
     entities, cell_values = distribute_entity_data(domain, tdim, cells, body)
     domain.topology.create_connectivity(tdim, 0)
-    cell_tags = meshtags_from_entities(domain, tdim, _adjacency(entities),
+    cell_tags = meshtags_from_entities(domain, tdim, _adjacency(domain, tdim, entities),
                                        cell_values.astype(np.int32))
     cell_tags.name = "Cell tags"
 
@@ -239,7 +245,8 @@ def merge_bodies(meshes: Sequence, facet_tags: Sequence, comm: Optional[MPI.Comm
     entities, facet_values = distribute_entity_data(domain, tdim - 1, facet_nodes,
                                                     np.concatenate(tag_values).astype(np.int32))
     domain.topology.create_connectivity(tdim - 1, tdim)
-    merged_tags = meshtags_from_entities(domain, tdim - 1, _adjacency(entities),
+    merged_tags = meshtags_from_entities(domain, tdim - 1,
+                                         _adjacency(domain, tdim - 1, entities),
                                          facet_values.astype(np.int32))
     merged_tags.name = "Facet tags"
     return domain, merged_tags, cell_tags

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from dolfinx import fem
+from dolfinx import fem, mesh
 from mpi4py import MPI
 
 import ufl
@@ -35,6 +35,22 @@ def test_three_meshes_merge_in_one_call():
     assert cells == [2 * 8 * 2, 2 * 9 * 2, 2 * 10 * 2]         # triangles of each block
     present = {int(v) for part in comm.allgather(np.unique(facet_tags.values)) for v in part}
     assert present == {LEFT} | {t + OFFSET * k for k in range(3) for t in (BOTTOM, TOP)}
+
+
+def test_ranks_that_hold_no_tagged_facet_merge_too():
+    """One tagged facet in all: on several ranks the others hold none (they got an
+    array without rows' width, which the merge once failed to reshape)."""
+    comm = MPI.COMM_WORLD
+    meshes = []
+    for k in range(2):
+        domain = mesh.create_rectangle(comm, [[0, k], [1, k + 1]], [6, 6])
+        corner = mesh.locate_entities_boundary(
+            domain, 1, lambda x: np.isclose(x[1], 0) & (x[0] < 0.2)) if k == 0 else []
+        meshes.append((domain, mesh.meshtags(domain, 1, np.asarray(corner, dtype=np.int32),
+                                             np.full(len(corner), BOTTOM, dtype=np.int32))))
+    domain, facet_tags, _ = merge_bodies([m for m, _ in meshes], [t for _, t in meshes])
+    owned = facet_tags.indices < domain.topology.index_map(1).size_local
+    assert comm.allreduce(int(np.sum(facet_tags.values[owned] == BOTTOM))) == 1
 
 
 def test_a_tag_that_marks_two_of_three_bodies_is_named():
