@@ -23,6 +23,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 import numpy.typing as npt
+from dolfinx import cpp
 from mpi4py import MPI
 
 from dolfinx_mortar import dolfinx_compat
@@ -52,7 +53,6 @@ def _owned_tagged_facets(domain, facet_tags):
     the coordinate element's closure order (vertices first), as
     ``distribute_entity_data`` reads them: ``entities_to_geometry`` gives only
     the vertices, which is wrong for quadratic geometry."""
-    from dolfinx import cpp
     topology = domain.topology
     tdim = topology.dim
     fdim = tdim - 1
@@ -80,9 +80,7 @@ def _adjacency(domain, dim: int, entities: npt.NDArray) -> object:
 
     The row width comes from the entity type, not from ``entities``: a rank that
     holds none of the tagged entities gets an empty array without a second axis."""
-    from dolfinx import cpp
-    entity_type = cpp.mesh.cell_entity_type(domain.topology.cell_type, dim, 0)
-    width = cpp.mesh.cell_num_entities(entity_type, 0)
+    width = cpp.mesh.cell_num_vertices(cpp.mesh.cell_entity_type(domain.topology.cell_type, dim, 0))
     entities = np.asarray(entities, dtype=np.int32).reshape(-1, width)
     offsets = np.arange(len(entities) + 1, dtype=np.int32) * entities.shape[1]
     return dolfinx_compat.adjacency_list(entities.ravel(), offsets)
