@@ -2,13 +2,21 @@
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
+from unittest import mock
 
 import numpy as np
 import pytest
 from mpi4py import MPI
 from support import DEMOS, load_demo
 
+
+
+def runtime_warnings(warn: mock.MagicMock) -> list[str]:
+    """The RuntimeWarnings among the calls a mock.patch of warnings.warn saw."""
+    return [str(c.args[0]) for c in warn.call_args_list
+            if RuntimeWarning in c.args[1:2] or c.kwargs.get("category") is RuntimeWarning]
 
 
 @pytest.fixture
@@ -143,6 +151,18 @@ def test_a_tube_squeezed_until_its_inner_faces_meet(out):
         assert (out / "tube.json").exists() and (out / "tube.png").exists()
 
 
+def test_a_tube_whose_hole_closes_warns_of_nothing():
+    """The tube at h = 0.05: the self-contact zone's edge is no sign of contact beyond
+    the search radius. The check searched without excluding the surface's own
+    neighbours: three wider searches (0.0756 to 4.84, twice the tube's size), each
+    step solved again, then a false "the pressure is cut off" warning; and a
+    "master faces away" warning when the term was made. The same force after."""
+    with mock.patch("warnings.warn", wraps=warnings.warn) as warn:
+        steps = load_demo("self_contact_tube").main(["--h", "0.05"])["steps"]
+    assert runtime_warnings(warn) == []
+    assert steps[-1]["plate_force"] == pytest.approx(-0.153263, rel=1e-5)
+
+
 def test_a_tube_in_3d_squeezed_until_its_inner_faces_meet():
     """The same, 3D: 0.3 of the tube (tetrahedra, h = 0.1), a symmetry plane at z = 0
     and a free end: self-contact and finite strain in 3D (measured: the faces meet
@@ -154,6 +174,45 @@ def test_a_tube_in_3d_squeezed_until_its_inner_faces_meet():
     force = np.array([-s["plate_force"] for s in steps])
     assert np.all(np.diff(force) > 0)
     assert force[-1] - force[-2] > 3 * (force[1] - force[0])
+
+
+def test_a_hollow_o_ring_squeezed_into_a_groove(out):
+    """The neo-Hookean hollow O-ring in (r, z) (h = 0.1, 10 steps of 0.095): only the
+    four rigid walls and its own hole hold it. Nothing but the lid and the floor acts in
+    z, so their forces balance to round-off (measured 2e-13 of the lid force); the
+    hole's faces push on each other, so the self-contact's resultant is zero (measured
+    4e-16). The ring bulges onto the outer wall first (measured at 0.38) and onto the
+    inner one later (0.665); the hole closes only once the ring is flattened (first at
+    0.855), and the lid force stiffens (5.38 per step at the end, 0.49 at the start).
+    1, 2 and 3 ranks give the same figures to 5e-13."""
+    # the calls themselves, not what the filters let through: under catch_warnings
+    # this warning went unrecorded when the demo ran first in the process (the filters
+    # had lost catch_warnings' "always" by then; the cause is not known)
+    with mock.patch("warnings.warn", wraps=warnings.warn) as warn:
+        figures = load_demo("o_ring_groove").main(
+            ["--h", "0.1", "--steps", "10", "--json", str(out / "o_ring.json"),
+             "--png", str(out / "o_ring.png")])
+    # a hole that starts open is the usual case: nothing to warn of (its own
+    # neighbours once read as a master that faces away, and, at the edge of the
+    # contact zone, as contact beyond the search radius: three wider searches)
+    assert runtime_warnings(warn) == []
+    steps = figures["steps"]
+    assert len(steps) == 10 and steps[-1]["squeeze"] == pytest.approx(0.95)
+    lid = np.array([s["lid_force"] for s in steps])
+    assert np.all(np.diff(lid) > 0) and lid[-1] - lid[-2] > 3 * lid[0]
+    for s in steps:
+        assert s["floor_force"] == pytest.approx(s["lid_force"], rel=1e-9)
+        assert np.linalg.norm(s["self_contact_resultant"]) < 1e-12 * s["lid_force"]
+    outer = [s["outer_wall_force"] > 0 for s in steps]
+    inner = [s["inner_wall_force"] > 0 for s in steps]
+    assert not any(outer[:3]) and all(outer[3:])
+    assert not any(inner[:6]) and all(inner[6:])
+    touching = [s["self_contact_nodes"] > 0 for s in steps]
+    assert not any(touching[:8]) and all(touching[8:])
+    assert steps[-1]["self_contact_nodes"] > 10 and steps[-1]["self_contact_pressure"] > 0
+    if MPI.COMM_WORLD.rank == 0:
+        assert json.loads((out / "o_ring.json").read_text())["steps"][-1]["lid_force"] == lid[-1]
+        assert (out / "o_ring.png").stat().st_size > 10_000
 
 
 def test_press_and_slide_frictionless_sliding_needs_no_tangential_force(out):

@@ -222,7 +222,10 @@ class RangeChecks:
         it never will be. ``coupling``: a segmentation of this configuration
         already made (None: one is made here).
         """
-        if self.term.master is None:
+        if self.term.master is None or self.term.options.self_contact:
+            # a surface is apart from itself at the start but for its own neighbours,
+            # which face the same way: the usual case, and the missed-contact check
+            # pairs what comes within reach later
             return
         comm = self.term.comm
         radius = self.term.options.search_radius
@@ -279,8 +282,11 @@ class RangeChecks:
         cached = self._beyond_radius
         if cached is None or cached[0] is not coupling:
             # one wider segmentation per frozen configuration, not one per step
+            # a self-contact surface without its own neighbours, as the term pairs it
+            # (with them, every node at the edge of a contact zone had a "master beyond")
             wider = MortarCoupling(coupling.slave, coupling.master,
-                                   search_radius=4 * coupling.search_radius)
+                                   search_radius=4 * coupling.search_radius,
+                                   self_contact=self.term.options.self_contact)
             cached = (coupling, slave.layout.on_cells(slave.cells[wider.pairs[:, 0]]))
             self._beyond_radius = cached
         reached = cached[1] & ~covered
