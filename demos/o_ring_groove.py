@@ -24,7 +24,7 @@ peak pressure (what seals) and the chord of the ring's undeformed surface that t
 the self-contact's peak pressure, where it peaks, its nodes and its resultant (zero: the hole's
 faces push on each other). The forces converge as h falls; the hole's peak pressure does not
 (it sits where the collapsed hole folds; docs/SELF_CONTACT.md has the figures at three h, and
-the step counts that converge at the finest). ``--json`` the figures, ``--png`` the forces
+how the steps change them at the finest). ``--json`` the figures, ``--png`` the forces
 and the peak pressures against the squeeze.
 
     python3 demos/o_ring_groove.py --json results/o_ring.json --png results/o_ring.png
