@@ -34,12 +34,12 @@ from __future__ import annotations
 import argparse
 from typing import Optional, Sequence
 
-import dolfinx.mesh
 import gmsh
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from demo_support.boundary_tags import tag_boundary_facets
 from demo_support.laws import neo_hookean_residual
 from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidPlane
 from dolfinx_mortar.io.gmsh_io import model_to_mesh
@@ -73,11 +73,7 @@ def ring_section(comm: MPI.Comm, h: float):
     distance = lambda x: np.hypot(x[0] - RC, x[1] - A)     # noqa: E731
     marks = [(INNER, lambda x: np.isclose(distance(x), B, atol=1e-3 * h)),
              (OUTER, lambda x: np.isclose(distance(x), A, atol=1e-3 * h))]
-    facets = [dolfinx.mesh.locate_entities_boundary(mesh, 1, where) for _, where in marks]
-    values = np.concatenate([np.full(len(f), t, np.int32) for f, (t, _) in zip(facets, marks)])
-    order = np.argsort(np.concatenate(facets))
-    return mesh, dolfinx.mesh.meshtags(mesh, 1, np.concatenate(facets)[order].astype(np.int32),
-                                       values[order])
+    return mesh, tag_boundary_facets(mesh, marks)
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:

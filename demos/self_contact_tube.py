@@ -19,13 +19,13 @@ from __future__ import annotations
 import argparse
 from typing import Optional, Sequence
 
-import dolfinx.mesh
 import gmsh
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
 from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidPlane
+from demo_support.boundary_tags import tag_boundary_facets
 from demo_support.laws import neo_hookean_residual
 from dolfinx_mortar.io.gmsh_io import model_to_mesh
 from dolfinx_mortar.io.output import save_figure, write_json
@@ -67,11 +67,7 @@ def tube(comm: MPI.Comm, h: float, length: float = 0.0):
              (CUT, lambda x: np.isclose(x[0], 0.0))]
     if length:
         marks.append((END, lambda x: np.isclose(x[2], 0.0)))
-    fdim = dim - 1
-    facets = [dolfinx.mesh.locate_entities_boundary(mesh, fdim, where) for _, where in marks]
-    values = np.concatenate([np.full(len(f), t, np.int32) for f, (t, _) in zip(facets, marks)])
-    facets, first = np.unique(np.concatenate(facets), return_index=True)
-    return mesh, dolfinx.mesh.meshtags(mesh, fdim, facets.astype(np.int32), values[first])
+    return mesh, tag_boundary_facets(mesh, marks)
 
 
 def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:

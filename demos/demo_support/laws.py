@@ -5,7 +5,7 @@ from __future__ import annotations
 import ufl
 from dolfinx import fem
 
-from dolfinx_mortar.small_strain.axisymmetric import circumference
+from dolfinx_mortar.small_strain.axisymmetric import circumference, radius
 
 
 def deformation_gradient(u: fem.Function, axisymmetric: bool = False) -> ufl.core.expr.Expr:
@@ -14,7 +14,7 @@ def deformation_gradient(u: fem.Function, axisymmetric: bool = False) -> ufl.cor
     F = ufl.Identity(len(u)) + ufl.grad(u)
     if not axisymmetric:
         return F
-    r = ufl.SpatialCoordinate(u.function_space.mesh)[0]
+    r = radius(u.function_space.mesh)
     return ufl.as_tensor([[F[0, 0], F[0, 1], 0.0],
                           [F[1, 0], F[1, 1], 0.0],
                           [0.0, 0.0, 1.0 + u[0] / r]])

@@ -20,6 +20,7 @@ import numpy as np
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
+from demo_support.boundary_tags import tag_boundary_facets
 from dolfinx_mortar import ContactProblem, RigidPlane, SurfacePressure
 
 R, W, H = 1.0, 0.5, 0.5
@@ -55,11 +56,7 @@ def body(comm: MPI.Comm, n: int, dim: int, mirrored: bool = False, lift: float =
              (SYMMETRY_X, lambda p: np.isclose(p[0], 0.0))]
     if dim == 3:
         marks.append((SYMMETRY_Y, lambda p: np.isclose(p[1], 0.0)))
-    fdim = dim - 1
-    facets = [mesh.locate_entities_boundary(domain, fdim, where) for _, where in marks]
-    values = np.concatenate([np.full(len(f), tag, np.int32) for f, (tag, _) in zip(facets, marks)])
-    facets, first = np.unique(np.concatenate(facets), return_index=True)
-    return domain, mesh.meshtags(domain, fdim, facets.astype(np.int32), values[first])
+    return domain, tag_boundary_facets(domain, marks)
 
 
 def _supports(dim: int, d: float, lower: bool = False) -> dict:

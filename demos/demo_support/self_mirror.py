@@ -17,9 +17,10 @@ from dataclasses import dataclass
 import basix.ufl
 import numpy as np
 import ufl
-from dolfinx import fem, mesh
+from dolfinx import fem
 from mpi4py import MPI
 
+from demo_support.boundary_tags import tag_boundary_facets
 from dolfinx_mortar import ContactProblem, RigidPlane, SurfacePressure
 from dolfinx_mortar.dolfinx_compat import create_mesh
 
@@ -104,11 +105,7 @@ def build(comm: MPI.Comm, h: float, whole: bool, thickness: float = 0.0):
         marks.append((BRIDGE, lambda p: np.isclose(p[1], 0.0) & (p[0] > W - tol)))
     if dim == 3:
         marks.append((SLAB, lambda p: np.isclose(p[2], 0.0) | np.isclose(p[2], thickness)))
-    fdim = dim - 1
-    facets = [mesh.locate_entities_boundary(domain, fdim, where) for _, where in marks]
-    values = np.concatenate([np.full(len(f), tag, np.int32) for f, (tag, _) in zip(facets, marks)])
-    facets, first = np.unique(np.concatenate(facets), return_index=True)
-    return domain, mesh.meshtags(domain, fdim, facets.astype(np.int32), values[first])
+    return domain, tag_boundary_facets(domain, marks)
 
 
 @dataclass

@@ -10,6 +10,7 @@ from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactProblem
 from support.jacobian_check import (convergence_order, energy_gradient_error, jacobian_error,
                                     newton_history)
+from demo_support.boundary_tags import tag_boundary_facets
 from support import load_demo
 from support.scenes import LOCAL_KINDS, block_on_plane, pressed_block
 
@@ -123,13 +124,7 @@ def test_current_jacobian_is_exact_in_3d():
     domain = mesh.create_box(MPI.COMM_WORLD, [[0, 0, 0], [1, 1, 0.5]], [4, 4, 2])
     marks = [(1, lambda x: np.isclose(x[2], 0)), (2, lambda x: np.isclose(x[2], 0.5)),
              (3, lambda x: np.isclose(x[0], 0)), (4, lambda x: np.isclose(x[1], 0))]
-    facets, values = [], []
-    for tag, where in marks:
-        f = mesh.locate_entities_boundary(domain, 2, where)
-        facets.append(f)
-        values.append(np.full(len(f), tag, dtype=np.int32))
-    facets, unique = np.unique(np.concatenate(facets), return_index=True)
-    tags = mesh.meshtags(domain, 2, facets.astype(np.int32), np.concatenate(values)[unique])
+    tags = tag_boundary_facets(domain, marks)
     V = fem.functionspace(domain, ("Lagrange", 1, (domain.geometry.dim,)))
     for kind in ("LcLS*", "LmLS"):
         problem = ContactProblem(V, tags, 1, obstacle=RigidSphere([0.5, 0.5, -2.0], 2.01),
