@@ -223,10 +223,7 @@ class RangeChecks:
         already made (None: one is made here).
         """
         if self.term.master is None or self.term.options.self_contact:
-            # a surface is apart from itself at the start but for its own neighbours,
-            # which face the same way: the usual case, and the missed-contact check
-            # pairs what comes within reach later
-            return
+            return  # self-contact starting apart is the usual case (MissedContact pairs it later)
         comm = self.term.comm
         radius = self.term.options.search_radius
         if coupling is None:        # the current surface: one segmentation for this check
@@ -281,9 +278,8 @@ class RangeChecks:
         coupling = model.coupling
         cached = self._beyond_radius
         if cached is None or cached[0] is not coupling:
-            # one wider segmentation per frozen configuration, not one per step
-            # a self-contact surface without its own neighbours, as the term pairs it
-            # (with them, every node at the edge of a contact zone had a "master beyond")
+            # one wider segmentation per frozen configuration, not one per step; without a
+            # self-contact surface's own neighbours, as the term pairs it
             wider = MortarCoupling(coupling.slave, coupling.master,
                                    search_radius=4 * coupling.search_radius,
                                    self_contact=self.term.options.self_contact)
