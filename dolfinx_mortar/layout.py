@@ -113,12 +113,25 @@ class NodeLayout:
                             minlength=self.size_local)
         return self.complete(local)
 
-    def complete(self, partial: FloatArray) -> FloatArray:
-        """Add partial values across ranks, then copy the totals to the ghosts."""
+    def max_at_functions(self, cells: IntArray, element_values: FloatArray) -> FloatArray:
+        """The largest over all elements on all ranks of element values at each
+        local function (0 at a function on no element; values ≥ 0).
+
+        A rank can own a function whose elements all live on other ranks (it
+        holds only the function's bulk cells): its local largest is 0 there.
+        """
+        local = np.zeros(self.size_local)
+        np.maximum.at(local, np.asarray(cells).ravel(), np.asarray(element_values).ravel())
+        return self.complete(local, PETSc.InsertMode.MAX)
+
+    def complete(self, partial: FloatArray,
+                 combine: PETSc.InsertMode = PETSc.InsertMode.ADD) -> FloatArray:
+        """Combine partial values across ranks (added, or ``PETSc.InsertMode.MAX``:
+        the largest), then copy the results to the ghosts."""
         vec = self._ghosted_vector()
         with vec.localForm() as lf:
             lf.array[:] = partial
-        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        vec.ghostUpdate(addv=combine, mode=PETSc.ScatterMode.REVERSE)
         vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         with vec.localForm() as lf:
             out = lf.array.copy()
@@ -157,9 +170,11 @@ def _block_matrix(rows: NodeLayout, cols: NodeLayout, bound: npt.NDArray,
     """A rows × cols AIJ matrix preallocated with ``bound`` nonzeros per owned
     row (more allocate as they come), with the blocks added (not assembled)."""
     bound = np.minimum(bound, cols.size_global).astype(PETSc.IntType)
+    # the diagonal part has this rank's owned columns, which can be none (a
+    # master surface on 8 ranks): PETSc refuses room for 1 in a part 0 wide
     mat = PETSc.Mat().createAIJ(((rows.num_owned, rows.size_global),
                                  (cols.num_owned, cols.size_global)),
-                                nnz=(np.minimum(bound, max(cols.num_owned, 1)), bound),
+                                nnz=(np.minimum(bound, cols.num_owned), bound),
                                 comm=rows.comm)
     mat.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
     nb, nr = row_global.shape

@@ -85,7 +85,9 @@ def contracted(jets, gdim: int) -> np.ndarray:
     """Each pair's gradients contracted with a field of the global dofs: the
     same whatever order the kernel lists a pair's variable nodes in."""
     nodes = np.maximum(jets.nodes, 0)
-    field = np.sin(1.0 + (nodes[..., None] * gdim + np.arange(gdim))).reshape(len(nodes), -1)
+    # the width spelled out: a rank without pairs (8 ranks) has no -1 to infer
+    field = np.sin(1.0 + (nodes[..., None] * gdim + np.arange(gdim))).reshape(
+        len(nodes), nodes.shape[1] * gdim)
     return np.einsum("pak,pk->pa", jets.gradient, field)
 
 
