@@ -158,10 +158,11 @@ RANKS_TESTS_3 = tests/mortar/test_surface_exchange.py tests/mortar/test_mortar_p
 RANKS_TESTS_4 = tests/contact/test_mirror.py tests/solver/test_problem.py::test_patch_test_passes_with_the_consistent_scaling \
 	tests/solver/test_two_meshes.py::test_patch_test_on_two_meshes_matches_one_mesh \
 	tests/contact/test_friction_scenes.py tests/contact/test_self_contact_friction.py
-# On 8 ranks, the same tests with the starred kinds (the unstarred share their code paths; 180 s
-# alone on 2 cores, 335 s with them), and any RuntimeWarning an error: on 8 ranks a slave node
-# can be owned by a rank that holds none of its facets, and until 2026-12-06 its element length
-# read 0 there and the patch tests warned of a slip of 1.9e305 element lengths, in a green run.
+# On 8 ranks, the same tests with the starred kinds (the unstarred share their code paths), the
+# layout's and the surface exchange's tests (some ranks own no slave or no master function
+# there), and any RuntimeWarning an error: until 2026-12-06 a node owned where none of its facets
+# are had element length 0, and the patch tests warned of a slip of 1.9e305 element lengths in a
+# green run (docs/SCALING.md, "8 ranks in make test"). 244 s alone on 2 cores (sid).
 # faulthandler_timeout: a test stuck that long prints every rank's Python stack (which
 # collective each waits in) before the step's timeout stops it.
 RANKS_8_SELECTION = not pointwise and not under_refinement and not GLS- and not LmLS- and not LcLS-
@@ -170,7 +171,8 @@ test-ranks:
 	tools/oversubscribed 4 300 $(PYTEST) -p no:cacheprovider -o faulthandler_timeout=150 \
 		-k "not pointwise and not under_refinement" $(RANKS_TESTS_4)
 	tools/oversubscribed 8 420 $(PYTEST) -p no:cacheprovider -o faulthandler_timeout=200 \
-		-W error::RuntimeWarning -k "$(RANKS_8_SELECTION)" $(RANKS_TESTS_4) tests/test_layout.py
+		-W error::RuntimeWarning -k "$(RANKS_8_SELECTION)" $(RANKS_TESTS_4) tests/test_layout.py \
+		tests/mortar/test_mortar_parallel.py tests/mortar/test_surface_exchange.py
 
 test-coretype:
 	@coretype=$(CORETYPE) && echo "OPENBLAS_CORETYPE=$$coretype" && \

@@ -77,7 +77,9 @@ def same(a, b, tol):
 def test_operators_agree_on_one_and_all_ranks(dim, degree, kind):
     D, M, gap, area, counts = operators(MPI.COMM_WORLD, dim, degree, kind)
     D0, M0, gap0, area0, _ = operators(MPI.COMM_SELF, dim, degree, kind)
-    assert min(counts) > 0  # every rank owns slave facets: the parallel path is used
+    # two ranks or more own slave facets: the parallel path is used (on 8 ranks
+    # some own none, and the operators must not depend on that either)
+    assert sum(c > 0 for c in counts) >= min(2, len(counts))
     expected = 0.7 if dim == 2 else 0.7 * 0.8
     assert area == pytest.approx(expected, rel=1e-12) and area0 == pytest.approx(expected, rel=1e-12)
     same(D, D0, 1e-12)
