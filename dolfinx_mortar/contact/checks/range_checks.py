@@ -23,6 +23,7 @@ from dolfinx_mortar.contact.checks.setup_checks import (check_initial_overlap,
 from dolfinx_mortar.contact.checks.thresholds import (BODY_PENETRATION, DEEP_PENETRATION,
                                                       MAX_RADIUS_WIDENINGS, PENALTY_PENETRATION,
                                                       SLIP_LIMIT, SUGGESTED_PENETRATION)
+from dolfinx_mortar.contact.gap_sources import pairing_options
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import DUAL_KINDS
 from dolfinx_mortar.mortar.coupling import MortarCoupling
@@ -278,11 +279,11 @@ class RangeChecks:
         coupling = model.coupling
         cached = self._beyond_radius
         if cached is None or cached[0] is not coupling:
-            # one wider segmentation per frozen configuration, not one per step; without a
-            # self-contact surface's own neighbours, as the term pairs it
+            # one wider segmentation per frozen configuration, not one per step; paired
+            # as the term pairs (its normals, a self-contact surface without its neighbours)
             wider = MortarCoupling(coupling.slave, coupling.master,
                                    search_radius=4 * coupling.search_radius,
-                                   self_contact=self.term.options.self_contact)
+                                   **pairing_options(self.term.options))
             cached = (coupling, slave.layout.on_cells(slave.cells[wider.pairs[:, 0]]))
             self._beyond_radius = cached
         reached = cached[1] & ~covered

@@ -11,6 +11,7 @@ from dolfinx_mortar.contact.gap_sources.slip import SlipOperator, StepStart
 from dolfinx_mortar.contact.gap_sources.source import GapSource, GlobalGapSource
 from dolfinx_mortar.contact.gap_sources.configuration import configuration_of
 from dolfinx_mortar.contact.gap_sources.current.mortar import FACET_SEARCH_FACTOR
+from dolfinx_mortar.contact.gap_sources.choice import pairing_options
 
 __all__ = ["FACET_SEARCH_FACTOR", "GapSource", "GlobalGapSource", "SlipOperator", "StepStart",
-           "configuration_of"]
+           "configuration_of", "pairing_options"]
