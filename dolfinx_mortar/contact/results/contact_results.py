@@ -34,6 +34,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.results.friction_results import FrictionResults, SurfaceFriction
 from dolfinx_mortar.contact.results.surface_nodes import at_surface_nodes, slave_resultant
 from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.mortar.surface_normals import normal_clusters, sum_over_clusters
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 
 FloatArray = npt.NDArray[np.float64]
@@ -69,6 +70,7 @@ class ContactResults:
         self.term = term
         # the friction figures are a part of their own, handed on below
         self._friction = FrictionResults(term)
+        self._node_lengths: Optional[FloatArray] = None
 
     def nodal_gaps(self) -> FloatArray:
         """``d̄_A`` (penetration positive) at the local slave-layout nodes."""
@@ -163,14 +165,27 @@ class ContactResults:
         return energy
 
     def node_lengths(self) -> FloatArray:
-        """Each local slave node's element length: the largest of its cells' on
-        any rank (collective). Not of this rank's cells alone: on 8 ranks a node
-        owned where none of its facets are had length 0, and its slip read
-        1.9e305 element lengths."""
-        slave = self.term.slave
-        cell_length = slave.tabulate().ds_weights.sum(axis=1) ** (1.0 / slave.tdim)
-        return slave.layout.max_at_functions(
-            slave.cells, np.repeat(cell_length[:, None], slave.cells.shape[1], axis=1))
+        """Each local slave node's element length (collective; of the reference
+        surface, found once): the largest of its cells' on any rank, and at a
+        node of a normal cluster (nodes joined by a facet of vanishing size,
+        :func:`~dolfinx_mortar.mortar.surface_normals.normal_clusters`) the
+        largest around the cluster. Not of this rank's cells alone: on 8 ranks
+        a node owned where none of its facets are had length 0, and its slip
+        read 1.9e305 element lengths. Not of the node's own cells alone: the end
+        node of a corner chamfer 7e-7 h long read the penalty's penetration of
+        1e-3 h as 1.4e3 of its element lengths, and warned of a low penalty."""
+        if self._node_lengths is None:
+            slave = self.term.slave
+            cell_length = slave.tabulate().ds_weights.sum(axis=1) ** (1.0 / slave.tdim)
+            at_nodes = np.repeat(cell_length[:, None], slave.cells.shape[1], axis=1)
+            lengths = slave.layout.max_at_functions(slave.cells, at_nodes)
+            clusters = normal_clusters(slave, slave.x)
+            if clusters:                 # the same dict on every rank
+                lengths = np.maximum(lengths, sum_over_clusters(
+                    slave, clusters, np.zeros((len(lengths), 0)), maxima=at_nodes))
+            lengths.flags.writeable = False
+            self._node_lengths = lengths
+        return self._node_lengths
 
     def deepest(self, depth: FloatArray) -> tuple[float, float, list]:
         """The largest ``depth`` in slave element lengths over the owned nodes of
