@@ -327,8 +327,9 @@ def steady_figures(rows: list[dict]) -> dict:
     def ripple(f: np.ndarray) -> float:
         """max − min of f about a least-squares quadratic in the slide: the
         slab's finite length bends the force history smoothly, and that trend is
-        not the discretization's ripple"""
-        trend = np.polyval(np.polyfit(slide, f, 2), slide)
+        not the discretization's ripple (a line through two steps: a quadratic
+        through them is underdetermined, and NumPy warned it poorly conditioned)"""
+        trend = np.polyval(np.polyfit(slide, f, min(2, len(slide) - 1)), slide)
         return float(np.ptp(f - trend) / abs(mean))
 
     return {"steady_steps": len(steady), "normal_mean": mean,

@@ -15,7 +15,7 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from dolfinx_mortar import KIND_NAMES, ContactProblem, ContactTerm, RigidPlane, RigidSphere
-from support import load_demo
+from support import POINTWISE_WITH_A_DUAL_KIND, load_demo
 from support.jacobian_check import (energy_gradient_error, has_gaps_of_both_signs,
                                     jacobian_error, newton_step_error)
 from support.meshes import rectangle
@@ -40,6 +40,7 @@ def deviation_from(problem, p: float) -> float:
     return float(np.max(np.abs(pressures / p - 1)))
 
 
+@POINTWISE_WITH_A_DUAL_KIND
 @pytest.mark.parametrize("orientation", ["finer-slave", "finer-master"])
 @pytest.mark.parametrize("active_set", ["nodal", "pointwise"])
 @pytest.mark.parametrize("kind", KIND_NAMES)

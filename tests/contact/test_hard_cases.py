@@ -16,7 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 import pytest
-from support import BENCHMARKS, load_script
+from support import BENCHMARKS, LOW_PENALTY, load_script
 
 scenes = load_script(BENCHMARKS / "hard_case_scenes.py")
 
@@ -99,6 +99,7 @@ _MODIFIED_SLIVER = ("the modified dual function of the sliver node averages the 
                     "(3D: 538)")
 
 
+@LOW_PENALTY
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("kind, modified", SWEEP_VARIANTS)
 def test_elastic_master_sweep_keeps_the_newton_matrix_conditioned(kind, modified, dim):

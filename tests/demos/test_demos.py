@@ -9,7 +9,7 @@ from unittest import mock
 import numpy as np
 import pytest
 from mpi4py import MPI
-from support import DEMOS, load_demo
+from support import DEMOS, LOW_PENALTY, load_demo
 
 
 
@@ -311,6 +311,7 @@ def test_ironing2d_is_path_independent_and_converges(out):
         assert png_path.stat().st_size > 10_000
 
 
+@LOW_PENALTY
 @pytest.mark.slow
 def test_ironing3d_runs_the_load_path_and_balances(out):
     """3D ironing, very coarse (h = 1.5, die 0.75, 3 + 3 steps): the whole load path

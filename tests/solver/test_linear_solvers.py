@@ -12,7 +12,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.small_strain.elastic import linear_elastic_residual
 from dolfinx_mortar.linalg.linear_solver import ITERATIVE_FROM_DOFS, choose_linear_solver
 from dolfinx_mortar.linalg.near_nullspace import body_labels, rigid_body_modes
-from support import load_demo
+from support import POINTWISE_WITH_A_DUAL_KIND, load_demo
 from support.scenes import pressed_block
 
 
@@ -155,6 +155,7 @@ def test_gamg_gets_the_rigid_body_modes_of_each_body(option):
     assert len(modes) == 3
 
 
+@POINTWISE_WITH_A_DUAL_KIND
 def test_iterative_path_in_2d_with_an_obstacle():
     """Pointwise active set (GMRES) and nodal (CG) against a rigid plane match
     their direct solutions."""

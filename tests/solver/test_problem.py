@@ -14,7 +14,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactDivergenceError, ContactProblem
 from support.jacobian_check import has_gaps_of_both_signs, newton_step_error
-from support import load_demo
+from support import LOW_PENALTY, load_demo
 from support.scenes import (ALL_KINDS, assert_same_hertz2d_figures_on_one_and_all_ranks,
                             block_on_plane, pressed_block)
 
@@ -373,6 +373,7 @@ def test_hertz3d_mesh_file_and_ranks_reproduce_the_builtin_scene(tmp_path_factor
         assert serial[key] == pytest.approx(builtin[key], rel=1e-8), key
 
 
+@LOW_PENALTY
 def test_gls_equals_the_dual_kind_when_the_gap_is_in_the_slave_space():
     """Flat obstacle, P1 facets: d is piecewise linear, so L⁻¹∫N d and the dual
     ∫M d/W both give the nodal values of d — the two problems coincide."""
