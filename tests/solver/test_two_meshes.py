@@ -153,7 +153,7 @@ def test_quadratic_geometry_keeps_curved_facets():
     block, block_tags = gmsh_blocks(comm, [dict(LOWER, nx=4, ny=2)], degree=2)
     merged, facet_tags, cell_tags = merge_meshes(block, block_tags, disk, disk_tags,
                                                  tag_offset=100)
-    assert merged.geometry.cmap.degree == 2
+    assert merged.ufl_domain().ufl_coordinate_element().degree == 2  # geometry.cmap: deprecated in 0.11
     assert (merged.geometry.index_map().size_global
             == block.geometry.index_map().size_global + disk.geometry.index_map().size_global)
     m = facet_moments(merged, facet_tags, [LOWER_TOP, BOTTOM, 107])
