@@ -10,11 +10,11 @@ from dolfinx_mortar.contact.gap_sources.cut_quadrature import positive_part_rule
 from dolfinx_mortar.contact.obstacles import RigidPlane, RigidSphere
 from dolfinx_mortar import ContactDivergenceError, ContactProblem
 from support.jacobian_check import jacobian_error
-from support import load_demo
+from support import POINTWISE_WITH_A_DUAL_KIND, load_demo
 from support.scenes import ALL_KINDS, block_on_plane, pressed_block
 
 # dual kinds appear here on purpose; the warning itself is tested at the end
-pytestmark = pytest.mark.filterwarnings("ignore:the pointwise active set with a dual kind")
+pytestmark = POINTWISE_WITH_A_DUAL_KIND
 
 
 @pytest.mark.parametrize("cell, gap, area", [

@@ -26,4 +26,5 @@ POINTWISE_WITH_A_DUAL_KIND = pytest.mark.filterwarnings(
     "ignore:the pointwise active set with a dual kind:RuntimeWarning")
 
 
-__all__ = ["REPO_ROOT", "DEMOS", "BENCHMARKS", "LOW_PENALTY", "POINTWISE_WITH_A_DUAL_KIND", "load_demo", "load_script"]
+__all__ = ["REPO_ROOT", "DEMOS", "BENCHMARKS", "LOW_PENALTY", "POINTWISE_WITH_A_DUAL_KIND",
+           "load_demo", "load_script"]
