@@ -101,20 +101,25 @@ class PairScene:
         np.add.at(summed, self.cs, cell_normals)
         return summed / np.linalg.norm(summed, axis=1)[:, None]
 
-    def values(self, xs, xm, candidates):
-        """The double instantiation: mortar_integrals' ∫ N_A d per pair."""
+    def values(self, xs, xm, candidates, with_mass: bool = False):
+        """The double instantiation: mortar_integrals' ∫ N_A d per pair (with
+        ``with_mass``, followed by its ∫ N_A N_B, row-major, as the Jets give them)."""
         r = _kernels.mortar_integrals(self.kind, xs, self.cs.astype(np.int32), self.normals(xs),
                                       self.kind, xm, self.cm.astype(np.int32),
                                       candidates.astype(np.int32), self.points, self.weights,
                                       True, length_scale=self.length_scale)
+        if with_mass:
+            return r.pairs, np.hstack([r.gap, r.D.reshape(len(r.pairs), -1)])
         return r.pairs, r.gap
 
-    def jets(self, xs, xm, pairs, with_hessian: bool = True, node_weights=None):
+    def jets(self, xs, xm, pairs, with_hessian: bool = True, node_weights=None,
+             with_mass: bool = False):
         """The Jet instantiation: ``current_pair_gaps`` (per node, or the
-        ``node_weights``-weighted sum per pair)."""
+        ``node_weights``-weighted sum per pair; ``with_mass``: also ∫ N_A N_B)."""
         gx, gc, gid = gathered(xs, self.cs)
         mx, mc, mid = gathered(xm, self.cm)
         return _kernels.current_pair_gaps(self.kind, gx, gc, gid, self.kind, mx, mc,
                                           mid + MASTER_ID_OFFSET, pairs.astype(np.int32),
                                           self.points, self.weights, self.zero,
-                                          with_hessian=with_hessian, node_weights=node_weights)
+                                          with_hessian=with_hessian, node_weights=node_weights,
+                                          with_mass=with_mass)

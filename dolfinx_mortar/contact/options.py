@@ -69,12 +69,22 @@ class ContactOptions:
             # the dual functions are negative near a facet's far node: a facet the
             # master covers only there reads a separation as a penetration. The
             # modification is the cure wherever it is implemented.
+            # Not for self-contact on the current surface (refused below).
             boundary_modification = (elastic_master and kind in DUAL_KINDS
-                                     and basis_configuration != "current"
-                                     and not law.pointwise)
-        if basis_configuration == "current" and boundary_modification:
+                                     and not law.pointwise
+                                     and not (self_contact and basis_configuration == "current"))
+        if basis_configuration == "current" and boundary_modification and law.pointwise:
             raise NotImplementedError("basis_configuration='current' with the boundary "
-                                      "modification is not implemented")
+                                      "modification and the pointwise active set is not "
+                                      "implemented; use active_set='nodal'")
+        if basis_configuration == "current" and boundary_modification and self_contact:
+            raise NotImplementedError(
+                "self_contact=True on the current surface with the boundary modification: "
+                "where the surface meets itself obliquely a facet is covered by its own "
+                "surface over a small piece only, and the basis rebuilt there extrapolates "
+                "that piece's gap to the far node (a false penetration of 0.3 element "
+                "lengths where the C body's arc meets its arm, docs/SELF_CONTACT.md); use "
+                "kind='LmLS*' or 'LmLS', or basis_configuration='previous'")
         if boundary_modification and not (elastic_master and kind in DUAL_KINDS):
             raise ValueError("the consistent boundary modification applies to the dual kinds "
                              "(LcLS*, LcLS) with an elastic master (master_tag)")

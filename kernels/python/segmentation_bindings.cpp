@@ -270,7 +270,8 @@ bind_segmentation(py::module_& m)
        bool with_hessian,
        bool with_positive_part,
        bool axisymmetric,
-       std::optional<array_t> node_weights)
+       std::optional<array_t> node_weights,
+       bool with_mass)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
@@ -282,7 +283,8 @@ bind_segmentation(py::module_& m)
                                     with_positive_part,
                                     axisymmetric,
                                     node_weights ? as_span(*node_weights)
-                                                 : std::span<const double>() };
+                                                 : std::span<const double>(),
+                                    with_mass };
       py::gil_scoped_release release;
       return current_pair_gaps(
         slave,
@@ -309,13 +311,15 @@ bind_segmentation(py::module_& m)
     py::arg("with_positive_part") = false,
     py::arg("axisymmetric") = false,
     py::arg("node_weights") = py::none(),
+    py::arg("with_mass") = false,
     "Current-configuration mortar gaps of cell pairs with exact gradients and "
     "Hessians "
     "(and, with_positive_part, the pointwise active set's integrals of <d> "
     "with their "
     "gradients); with node_weights (pairs, ns), those of the one function "
     "sum_A w_A c_A "
-    "per pair instead");
+    "per pair instead; with_mass, also the covered mass L_AB = int N_A N_B "
+    "(ns^2 functions after the ns c_A; node_weights then (pairs, ns + ns^2))");
 
   using ND = NormalDerivatives;
   py::class_<ND>(

@@ -101,10 +101,11 @@ check_input(const FacetSurface& slave,
     throw std::invalid_argument("quadrature points must have shape (points, " +
                                 std::to_string(gdim - 1) + ")");
   const int ns = facet_num_nodes(slave.type);
+  const int nw = ns + (options.with_mass ? ns * ns : 0);
   const bool weighted = !options.node_weights.empty();
-  if (weighted and options.node_weights.size() != pairs.size() / 2 * ns)
+  if (weighted and options.node_weights.size() != pairs.size() / 2 * nw)
     throw std::invalid_argument("node_weights must have shape (pairs, " +
-                                std::to_string(ns) + ")");
+                                std::to_string(nw) + ")");
   if (weighted and options.with_positive_part)
     throw std::invalid_argument(
       "node_weights combine c_A only, not the positive part's c⁺_A");
@@ -127,14 +128,16 @@ current_pair_gaps(const FacetSurface& slave,
               with_hessian,
               with_positive_part,
               axisymmetric,
-              node_weights] = options;
+              node_weights,
+              with_mass] = options;
   check_input(slave, slave_ids, master, master_ids, pairs, options);
   const int gdim = slave.gdim;
   const int ns = facet_num_nodes(slave.type), nm = facet_num_nodes(master.type);
   const int N = (2 * ns + nm) * gdim;
   const bool weighted = !node_weights.empty();
-  // functions per pair: the ns c_A, or their one weighted sum
-  const int nf = weighted ? 1 : ns;
+  // functions per pair: the ns c_A (and the ns² L_AB), or one weighted sum
+  const int nw = ns + (with_mass ? ns * ns : 0);
+  const int nf = weighted ? 1 : nw;
   const int NG = (ns + nm) * gdim;
   const InnerFunction inner =
     with_hessian ? inner_for<2>(N, NG) : inner_for<1>(N, NG);
@@ -210,7 +213,8 @@ current_pair_gaps(const FacetSurface& slave,
                                     zero,
                                     opposing_normals_only,
                                     axisymmetric,
-                                    weighted ? node_weights.subspan(p * ns, ns)
+                                    with_mass,
+                                    weighted ? node_weights.subspan(p * nw, nw)
                                              : std::span<const double>(),
                                     value,
                                     grad,

@@ -18,8 +18,10 @@ namespace
 /// c_A of one pair as Jets over its slave coordinates, nodal normals and
 /// master coordinates (in that order); returns failed projections. Order 1:
 /// no Hessian (@p hess untouched). Non-empty @p value_plus: also c⁺_A =
-/// ∫ N_A ⟨d⟩ and its gradient (@p grad_plus). Non-empty @p node_weights
-/// (ns): the one function Σ_A w_A c_A instead of the ns c_A. The geometry
+/// ∫ N_A ⟨d⟩ and its gradient (@p grad_plus). @p with_mass: also the covered
+/// mass L_AB = ∫ N_A N_B, ns² functions after the ns c_A (row-major).
+/// Non-empty @p node_weights (ns, or ns + ns² with the mass): the one
+/// function Σ_A w_A c_A (+ Σ_AB w_AB L_AB) instead. The geometry
 /// runs on Jets over the NG = N − ns·gdim coordinates only (integrate_pieces).
 template<int N, int NG, int Order>
 std::int64_t
@@ -34,6 +36,7 @@ inner_pair_derivatives(FacetType slave_type,
                        double zero,
                        bool opposing_normals_only,
                        bool axisymmetric,
+                       bool with_mass,
                        std::span<const double> node_weights,
                        std::span<double> value,
                        std::span<double> grad,
@@ -59,7 +62,8 @@ inner_pair_derivatives(FacetType slave_type,
   auto lift = [split, shift](const G& x) { return widen<N>(x, split, shift); };
   const int ns = facet_num_nodes(slave_type);
   const bool weighted = !node_weights.empty();
-  std::vector<J> c(weighted ? 1 : ns, J(0.0)),
+  const int nf = ns + (with_mass ? ns * ns : 0);
+  std::vector<J> c(weighted ? 1 : nf, J(0.0)),
     cp(value_plus.empty() ? 0 : ns, J(0.0));
   auto accumulate = [&](const SegmentPoint<J>& q)
   {
@@ -71,10 +75,32 @@ inner_pair_derivatives(FacetType slave_type,
       for (int a = 0; a < ns; ++a)
         combination.add_scaled(node_weights[a], q.slave_N[a]);
       c[0] += wd * combination;
+      if (with_mass)
+      {
+        // Σ_AB w_AB N_A N_B = Σ_A N_A (Σ_B w_AB N_B)
+        J mass(0.0);
+        for (int a = 0; a < ns; ++a)
+        {
+          J row(0.0);
+          for (int b = 0; b < ns; ++b)
+            row.add_scaled(node_weights[ns + a * ns + b], q.slave_N[b]);
+          mass += q.slave_N[a] * row;
+        }
+        c[0] += q.weight * mass;
+      }
     }
     else
+    {
       for (int a = 0; a < ns; ++a)
         c[a] += wd * q.slave_N[a];
+      if (with_mass)
+        for (int a = 0; a < ns; ++a)
+        {
+          const J wa = q.weight * q.slave_N[a];
+          for (int b = a; b < ns; ++b)
+            c[ns + a * ns + b] += wa * q.slave_N[b];
+        }
+    }
     if (cp.empty())
       return;
     // ⟨d⟩, decided on the value (as the double segmentation's points are)
@@ -99,6 +125,10 @@ inner_pair_derivatives(FacetType slave_type,
     false, // c_A needs no master shape functions
     lift,
     accumulate);
+  if (with_mass and !weighted) // the mass is symmetric: its lower triangle
+    for (int a = 0; a < ns; ++a)
+      for (int b = 0; b < a; ++b)
+        c[ns + a * ns + b] = c[ns + b * ns + a];
   for (std::size_t a = 0; a < c.size(); ++a)
   {
     value[a] = c[a].v;

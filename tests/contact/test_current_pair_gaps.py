@@ -21,13 +21,18 @@ def _moved(case, node_id: int, k: int, h: float):
     return xs, xm
 
 
+@pytest.mark.parametrize("with_mass", [False, True], ids=["gaps", "gaps-and-mass"])
 @pytest.mark.parametrize("kind", ["P1_line", "P2_line", "P1_triangle", "Q1_quadrilateral"])
-def test_jet_values_equal_the_double_kernel_and_derivatives_are_exact(kind):
+def test_jet_values_equal_the_double_kernel_and_derivatives_are_exact(kind, with_mass):
+    """``with_mass``: also the covered mass ∫ N_A N_B of each pair (the dual basis
+    rebuilt over the covered part on the current surface), after the gaps."""
     case = PairScene(kind)
     candidates = np.array([(i, j) for i in range(len(case.cs)) for j in range(len(case.cm))])
-    pairs, gaps = case.values(case.xs, case.xm, candidates)
+    pairs, gaps = case.values(case.xs, case.xm, candidates, with_mass)
     assert len(pairs) >= 6
-    r = case.jets(case.xs, case.xm, pairs)
+    r = case.jets(case.xs, case.xm, pairs, with_mass=with_mass)
+    ns = case.cs.shape[1]
+    assert r.value.shape == (len(pairs), ns + (ns * ns if with_mass else 0))
     # values: the same algorithm in two scalar types, equal to round-off
     scale = np.max(np.abs(gaps))
     assert scale > 0 and np.max(np.abs(r.value - gaps)) <= 1e-13 * scale
@@ -45,8 +50,10 @@ def test_jet_values_equal_the_double_kernel_and_derivatives_are_exact(kind):
                 continue
             for k in range(gdim):
                 column = v * gdim + k
-                plus = case.jets(*_moved(case, node_id, k, h), pairs[p:p + 1])
-                minus = case.jets(*_moved(case, node_id, k, -h), pairs[p:p + 1])
+                plus = case.jets(*_moved(case, node_id, k, h), pairs[p:p + 1],
+                                 with_mass=with_mass)
+                minus = case.jets(*_moved(case, node_id, k, -h), pairs[p:p + 1],
+                                  with_mass=with_mass)
                 fd_grad[:, column] = (plus.value[0] - minus.value[0]) / (2 * h)
                 # the perturbed pair's variables are the same nodes in the same
                 # order (alone, it is not padded)
@@ -92,16 +99,19 @@ def test_unsupported_facets_are_named():
 
 
 @pytest.mark.parametrize("kind", ["P1_line", "P2_line", "P1_triangle", "Q1_quadrilateral"])
-def test_weighted_sum_equals_the_sum_of_the_weighted_functions(kind):
+@pytest.mark.parametrize("with_mass", [False, True], ids=["gaps", "gaps-and-mass"])
+def test_weighted_sum_equals_the_sum_of_the_weighted_functions(kind, with_mass):
     """``node_weights``: the kernel's one function Σ_A w_A c_A per pair (what a
     Newton matrix needs) is the weighted sum of the ns functions, value, gradient
-    and Hessian."""
+    and Hessian; with the mass, of its ns + ns² functions."""
     case = PairScene(kind)
     candidates = np.array([(i, j) for i in range(len(case.cs)) for j in range(len(case.cm))])
     pairs, _ = case.values(case.xs, case.xm, candidates)
-    weights = np.random.default_rng(3).uniform(-1, 2, (len(pairs), case.cs.shape[1]))
-    apart = case.jets(case.xs, case.xm, pairs)
-    summed = case.jets(case.xs, case.xm, pairs, node_weights=weights)
+    ns = case.cs.shape[1]
+    weights = np.random.default_rng(3).uniform(-1, 2, (len(pairs),
+                                                       ns + (ns * ns if with_mass else 0)))
+    apart = case.jets(case.xs, case.xm, pairs, with_mass=with_mass)
+    summed = case.jets(case.xs, case.xm, pairs, node_weights=weights, with_mass=with_mass)
     assert np.array_equal(summed.nodes, apart.nodes)
     for key in ("value", "gradient", "hessian"):
         whole, parts = getattr(summed, key), getattr(apart, key)
@@ -111,7 +121,8 @@ def test_weighted_sum_equals_the_sum_of_the_weighted_functions(kind):
         assert scale > 0
         assert np.max(np.abs(whole[:, 0] - expected)) <= 1e-13 * scale, key
     # the gradients alone, too
-    alone = case.jets(case.xs, case.xm, pairs, with_hessian=False, node_weights=weights)
+    alone = case.jets(case.xs, case.xm, pairs, with_hessian=False, node_weights=weights,
+                      with_mass=with_mass)
     assert np.allclose(alone.gradient, summed.gradient, rtol=0,
                        atol=1e-13 * np.max(np.abs(summed.gradient)))
 

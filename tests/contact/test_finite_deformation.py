@@ -205,7 +205,7 @@ def test_current_configuration_reports_what_it_cannot_do():
             ContactProblem(V3, cube_tags, 1, master_tag=2, kind="LcLS*", **common)
     with pytest.raises(NotImplementedError, match="boundary modification"):
         ContactProblem(V, tags, 1, master_tag=2, kind="LcLS*", boundary_modification=True,
-                       **common)
+                       active_set="pointwise", **common)
     V2 = fem.functionspace(V.mesh, ("Lagrange", 2, (V.mesh.geometry.dim,)))
     with pytest.raises(NotImplementedError, match="P1 lines or triangles"):
         ContactProblem(V2, tags, 1, obstacle=RigidPlane([0, 0], [0, 1]), kind="LcLS*",

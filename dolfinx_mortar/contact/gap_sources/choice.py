@@ -37,9 +37,11 @@ def current_model(options: ContactOptions, slave: LagrangeSurface,
     if obstacle is not None:
         model = CurrentObstacleGap(slave, obstacle, options.kind, options.law)
     elif options.self_contact:
-        model = CurrentSelfContactGap(slave, options.kind, options.law, options.search_radius)
+        model = CurrentSelfContactGap(slave, options.kind, options.law, options.search_radius,
+                                      options.boundary_modification)
     else:
-        model = CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius)
+        model = CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius,
+                                 options.boundary_modification)
     model.frozen_at = partial(frozen_model, options, slave, master, obstacle)
     return model
 
@@ -100,17 +102,17 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     edge), ``∫ M̄_A d`` turns a separation into a penetration (two equal
     cylinders at u = 0: 0.009 where the search radius cuts, 0.037 at the
     surfaces' end with a larger radius, and Newton diverged to vertices of
-    1e87). In the initial
-    and previous configurations the boundary modification cures it; on the
-    current surface it is not differentiated (which elements are partly
-    covered changes with u). Its nodal gaps are compared here, where the term
-    is made, with the modified ones of the frozen model: a node that only the
-    current surface sees penetrating stops the construction, with the way
-    out. A master that covers the slave's elements in full (a cylinder on a
+    1e87). The boundary modification cures it, on the current surface too
+    (where it is the default); this check is for the current surface without
+    it (self-contact, where it is refused, or turned off). Its nodal gaps are
+    compared here, where the term is made, with the modified ones of the
+    frozen model: a node that only the current surface sees penetrating stops
+    the construction, with the way out. A master that covers the slave's elements in full (a cylinder on a
     wider block) passes. Returns the frozen model's coupling where it was made
     (None elsewhere), for the term's other checks.
     """
-    if not (master is not None and options.kind in DUAL_KINDS and not options.law.pointwise):
+    if not (master is not None and options.kind in DUAL_KINDS and not options.law.pointwise
+            and not options.boundary_modification):
         return None
     frozen = replace(options, basis_configuration="previous", boundary_modification=True)
     modified = frozen_model(frozen, slave, master, None, u_nodes, u.x.petsc_vec.copy())
@@ -135,6 +137,6 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
         f"a false penetration at {count} slave node(s) (largest {worst[0]:.3g} at {where}): "
         "the master covers their elements only in part (cut by the search radius or the "
         "master's edge), where the dual functions are negative. The boundary modification "
-        "that cures this in the 'initial' and 'previous' configurations is not "
-        "differentiated for 'current'. Use a kind with positive functions (kind='LmLS*' or "
-        "'LmLS') or basis_configuration='previous'.")
+        "cures this (boundary_modification=True, the default between two bodies; refused in "
+        "self-contact on the current surface). Use a kind with positive functions "
+        "(kind='LmLS*' or 'LmLS') or basis_configuration='previous'.")

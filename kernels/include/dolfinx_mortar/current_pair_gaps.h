@@ -18,7 +18,7 @@ namespace dolfinx_mortar
 struct PairGapDerivatives
 {
   std::size_t num_pairs = 0; ///< pairs
-  int functions = 0;         ///< functions per pair: ns, or 1 with node weights
+  int functions = 0; ///< per pair: ns (+ ns² with the mass), or 1 with weights
   int slave_nodes = 0;       ///< ns, nodes of a slave cell
   int gdim = 0;              ///< geometric dimension
   int num_nodes = 0; ///< variable nodes per pair (padded to the largest)
@@ -95,6 +95,10 @@ struct PairGapOptions
   /// a Newton matrix needs only this weighted sum of the Hessians, at a
   /// fraction of the cost and memory of the ns apart
   std::span<const double> node_weights;
+  /// Also the covered mass L_AB = ∫ N_A N_B of each pair (ns² functions after
+  /// the ns c_A, row-major: functions ns + ns²), which a dual basis rebuilt
+  /// over the covered part needs; node_weights then has ns + ns² per pair
+  bool with_mass = false;
 };
 
 /// c_A and its derivatives for every pair: integrate_pieces instantiated with

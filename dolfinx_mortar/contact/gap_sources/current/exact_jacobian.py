@@ -69,10 +69,11 @@ def exact_jacobian(source, state: ContactState, active: FloatArray, mask: Option
         width = source.cell_dofs.shape[1]
         blocks = np.zeros((len(source.cell_dofs), width, width))
     else:
-        blocks = source._cell_hessians(state.x, state.obstacle, state.FW, state.Fg)
+        blocks = source._cell_hessians(state.x, state.obstacle, state.FW_cells, state.Fg)
     K_el = assemble_blocks(source.dofs, source.cell_dofs_local, source.dofs, source.cell_dofs,
                            blocks)
-    pairs = source._gap_hessian(state.source, None if structure_only else state.Fg)
+    pairs = source._gap_hessian(state.source, None if structure_only else state.Fg,
+                                None if structure_only else state.FW)
     if pairs is not None:
         K_el.axpy(1.0, pairs, structure=Different)
     if mask is not None:

@@ -83,6 +83,12 @@ class SourceGaps:
     g_plus: Optional[FloatArray] = None
     G_g_plus: Optional[PETSc.Mat] = None
     data: Any = None
+    #: C of the gap basis φ = N C on every slave cell (None: the source's one C)
+    coefficients: Optional[FloatArray] = None
+    #: with a basis rebuilt over the covered part: ``W_A = ∫_cov N_A`` (0 where no
+    #: pair covers the node), which replaces W where it is not 0, and ∂W/∂u there
+    covered_weights: Optional[FloatArray] = None
+    G_covered_weights: Optional[PETSc.Mat] = None
 
 
 @dataclass
@@ -90,7 +96,7 @@ class CurrentState:
     """Nodal quantities and their derivatives at one displacement."""
 
     g: FloatArray            #: ĝ_A
-    W: FloatArray            #: W_A on the current surface
+    W: FloatArray            #: W_A on the current surface (its covered part: SourceGaps)
     y: FloatArray            #: nodal gaps ĝ_A W_A^{−k}
     G_g: PETSc.Mat           #: ∂ĝ/∂u
     G_W: PETSc.Mat           #: ∂W/∂u
@@ -98,6 +104,8 @@ class CurrentState:
     residual: PETSc.Vec      #: ∂Π/∂u
     Fg: FloatArray           #: ∂F/∂ĝ_A at the local nodes
     FW: FloatArray           #: ∂F/∂W_A at the local nodes
+    #: ∂F/∂W_A where W_A comes from the cells' own W (FW elsewhere: from the pairs)
+    FW_cells: FloatArray
     x: FloatArray            #: (cells, nodes, gdim) the slave cells' current nodes
     obstacle: Optional[ObstaclePoints]  #: an obstacle's gap at their points
     source: SourceGaps       #: what the gap's source gave
@@ -106,6 +114,9 @@ class CurrentState:
     #: pointwise active set: y⁺ = ĝ⁺ W^{−k} with ĝ⁺_A = ∫ φ_A ⟨d⟩ da, and ∂y⁺/∂u
     y_plus: Optional[FloatArray] = None
     G_y_plus: Optional[PETSc.Mat] = None
+    #: ``W_A = ∫ N_A`` over the whole current surface (W: over the covered part, where
+    #: the basis is rebuilt over it)
+    W_whole: Optional[FloatArray] = None
 
 
 class CurrentSurfaceGap(GapSourceBase):
@@ -205,11 +216,13 @@ class CurrentSurfaceGap(GapSourceBase):
         ``cells`` the kernel's cell quantities (with the obstacle's gaps)."""
         raise NotImplementedError
 
-    def _gap_hessian(self, source: SourceGaps, Fg: Optional[FloatArray]) -> Optional[PETSc.Mat]:
+    def _gap_hessian(self, source: SourceGaps, Fg: Optional[FloatArray],
+                     FW: Optional[FloatArray] = None) -> Optional[PETSc.Mat]:
         """``Σ_A F_g,A ∂²ĝ_A/∂u²`` where it does not come with the cells' own
-        (dofs × dofs, Dirichlet rows not yet dropped); ``Fg=None``: a matrix
-        with every entry it may have (values arbitrary). None: nothing beyond
-        the cells'."""
+        (dofs × dofs, Dirichlet rows not yet dropped), and ``Σ_A F_W,A ∂²W_A``
+        where W comes from the source (``source.covered_weights``); ``Fg=None``:
+        a matrix with every entry it may have (values arbitrary). None: nothing
+        beyond the cells'."""
         return None
 
     # -- cell quantities ---------------------------------------------------------------
@@ -270,6 +283,15 @@ class CurrentSurfaceGap(GapSourceBase):
         W = self._lumped_weights(surface)
         G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs, surface.W_gradient)
         source = self._gap(u_nodes, W, surface)
+        W_whole, from_cells = W, np.ones_like(W)
+        if source.covered_weights is not None:
+            # a covered node's W is ∫_cov N_A, with the pairs' derivatives
+            on = source.covered_weights > 0      # 0 exactly where no pair covers it
+            W = np.where(on, source.covered_weights, W)
+            from_cells = (~on).astype(np.float64)
+            G_W.diagonalScale(layout.vector(from_cells), None)
+            G_W.axpy(1.0, source.G_covered_weights,
+                     structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         g, G_g, G_g_plus = source.g, source.G_g, source.G_g_plus
         if mask is not None:
             G_g.diagonalScale(None, mask)
@@ -291,10 +313,12 @@ class CurrentSurfaceGap(GapSourceBase):
         residual.axpy(1.0, tmp)
         G_y = self._nodal_gap_derivative(G_g, G_W, y, Wsafe)
         # M̄ = φ W^{-k}: the functions whose integrals are the nodal gaps y
-        coefficients = law.nodal_gaps(np.broadcast_to(self.C, (nc, nd, nd)),
-                                      Wsafe[cells][:, None, :])
-        return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, x, obstacle, source,
-                            law.weights(Wsafe), coefficients, y_plus, G_y_plus)
+        C = (source.coefficients if source.coefficients is not None
+             else np.broadcast_to(self.C, (nc, nd, nd)))
+        coefficients = law.nodal_gaps(C, Wsafe[cells][:, None, :])
+        return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, FW * from_cells, x,
+                            obstacle, source, law.weights(Wsafe), coefficients, y_plus,
+                            G_y_plus, W_whole)
 
     def _nodal_gap_derivative(self, G_g: PETSc.Mat, G_W: PETSc.Mat, y: FloatArray,
                               Wsafe: FloatArray) -> PETSc.Mat:
@@ -341,7 +365,10 @@ class CurrentSurfaceGap(GapSourceBase):
         """Π_c summed over all ranks (for checking the residual)."""
         _, _, surface = self._cells_at(u_nodes)
         W = self._lumped_weights(surface)
-        g = self._gap(u_nodes, W, surface).g
+        source = self._gap(u_nodes, W, surface)
+        g = source.g
+        if source.covered_weights is not None:
+            W = np.where(source.covered_weights > 0, source.covered_weights, W)
         W = safe_weights(W)
         n = self.slave.layout.num_owned
         local = np.sum(self.law.energy(g, W)[:n])

@@ -25,9 +25,11 @@ from petsc4py import PETSc
 
 from dolfinx_mortar import _kernels
 from dolfinx_mortar.tolerance import NEAR_CONTACT
+from dolfinx_mortar.contact.gap_sources.current.covered_assembly import (covered_gap,
+                                                                          covered_hessian)
 from dolfinx_mortar.contact.gap_sources.current.finite_deformation import CurrentSurfaceGap, SourceGaps
 from dolfinx_mortar.contact.laws import PenaltyLaw, safe_weights
-from dolfinx_mortar.kinds import BasisKind
+from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling, polynomial_degree, segment_quadrature
 from dolfinx_mortar.mortar.pair_share import DealtPairs, deal_evenly, own_pairs
@@ -73,12 +75,17 @@ class CurrentMortarGap(CurrentSurfaceGap):
         As for :class:`~dolfinx_mortar.mortar.coupling.MortarCoupling` (pairs are found
         again at every evaluation); default: each slave facet searches
         :data:`FACET_SEARCH_FACTOR` of its own diameters.
+    boundary_modification
+        The dual kinds with the nodal active set: their basis rebuilt over the
+        covered part of each slave cell at every evaluation, exactly
+        differentiated (:mod:`~dolfinx_mortar.contact.gap_sources.current.covered_dual`).
     """
 
     moving_pattern = True
 
     def __init__(self, slave: LagrangeSurface, master: LagrangeSurface, kind: BasisKind,
-                 law: PenaltyLaw, search_radius: Optional[float] = None):
+                 law: PenaltyLaw, search_radius: Optional[float] = None,
+                 boundary_modification: bool = False):
         if slave.gdim == 3 and not (slave.reference.name in SUPPORTED_3D
                                     and master.reference.name in SUPPORTED_3D):
             raise NotImplementedError(
@@ -90,6 +97,10 @@ class CurrentMortarGap(CurrentSurfaceGap):
             raise ValueError("slave and master must share one displacement space (one mesh)")
         super().__init__(slave, kind, law)
         self.master, self.search_radius = master, search_radius
+        if boundary_modification and not (kind in DUAL_KINDS and not self.pointwise):
+            raise ValueError("the boundary modification applies to the dual kinds (LcLS*, "
+                             "LcLS) with the nodal active set")
+        self.boundary_modification = boundary_modification
         #: the slave surface is its own master (pairs without a facet's neighbours)
         self.self_contact = master is slave
         # both surfaces relative to the slave's origin (CurrentSurfaceGap.origin)
@@ -110,8 +121,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
 
     def dealt_pair_derivatives(self, dealt: DealtPairs, zero_length: float,
                                with_hessian: bool, with_positive_part: bool = False,
-                               node_weights: Optional[FloatArray] = None
-                               ) -> _kernels.PairGapDerivatives:
+                               node_weights: Optional[FloatArray] = None,
+                               with_mass: bool = False) -> _kernels.PairGapDerivatives:
         """``c_A = ∫ N_A d`` of the pairs ``dealt`` to this rank (any rank's:
         :func:`~dolfinx_mortar.mortar.pair_share.deal_evenly`) with exact
         derivatives (the Hessians only with ``with_hessian``).
@@ -126,7 +137,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
         """
         return dealt.gap_jets(self.segment_points, self.segment_weights, zero_length,
                               with_hessian=with_hessian, with_positive_part=with_positive_part,
-                              axisymmetric=self.slave.axisymmetric, node_weights=node_weights)
+                              axisymmetric=self.slave.axisymmetric, node_weights=node_weights,
+                              with_mass=with_mass)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, W: FloatArray,
@@ -144,6 +156,8 @@ class CurrentMortarGap(CurrentSurfaceGap):
                                                        else None),
                                   keep_points=self.pointwise, self_contact=self.self_contact,
                                   deal_segmentation=True)
+        if self.boundary_modification:
+            return covered_gap(self, coupling, W, surface.W)
         all_cells = slave.cells[coupling.pairs[:, 0]]
         # the values of every pair from the double kernel; derivatives only
         # where a node may carry contact force or stiffness
@@ -218,8 +232,11 @@ class CurrentMortarGap(CurrentSurfaceGap):
         return (nodes[..., None] * gdim + np.arange(gdim)).reshape(num_pairs,
                                                                    nodes.shape[1] * gdim)
 
-    def _gap_hessian(self, source: SourceGaps, Fg: Optional[FloatArray]) -> PETSc.Mat:
+    def _gap_hessian(self, source: SourceGaps, Fg: Optional[FloatArray],
+                     FW: Optional[FloatArray] = None) -> PETSc.Mat:
         data = source.data
+        if self.boundary_modification:
+            return covered_hessian(self, data, Fg, FW)
         dofs = data.dofs
         if Fg is None:
             # the pattern: each kept pair's variables couple with each other
