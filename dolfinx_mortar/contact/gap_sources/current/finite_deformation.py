@@ -90,6 +90,21 @@ class SourceGaps:
     covered_weights: Optional[FloatArray] = None
     G_covered_weights: Optional[PETSc.Mat] = None
 
+    def lumped_weights(self, W: FloatArray, G_W: Optional[PETSc.Mat] = None,
+                       layout=None) -> tuple[FloatArray, FloatArray]:
+        """The law's W: the cells' ``W`` (its derivative ``G_W``), with the covered
+        part's where the source gives it; and per node, 1 where W is the cells' and
+        0 where it is the pairs'. ``G_W``'s rows are made the same (in place)."""
+        if self.covered_weights is None:
+            return W, np.ones_like(W)
+        on = self.covered_weights > 0      # 0 exactly where no pair covers the node
+        from_cells = (~on).astype(np.float64)
+        if G_W is not None:
+            G_W.diagonalScale(layout.vector(from_cells), None)
+            G_W.axpy(1.0, self.G_covered_weights,
+                     structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        return np.where(on, self.covered_weights, W), from_cells
+
 
 @dataclass
 class CurrentState:
@@ -283,15 +298,8 @@ class CurrentSurfaceGap(GapSourceBase):
         W = self._lumped_weights(surface)
         G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs, surface.W_gradient)
         source = self._gap(u_nodes, W, surface)
-        W_whole, from_cells = W, np.ones_like(W)
-        if source.covered_weights is not None:
-            # a covered node's W is ∫_cov N_A, with the pairs' derivatives
-            on = source.covered_weights > 0      # 0 exactly where no pair covers it
-            W = np.where(on, source.covered_weights, W)
-            from_cells = (~on).astype(np.float64)
-            G_W.diagonalScale(layout.vector(from_cells), None)
-            G_W.axpy(1.0, source.G_covered_weights,
-                     structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        W_whole = W
+        W, from_cells = source.lumped_weights(W, G_W, layout)
         g, G_g, G_g_plus = source.g, source.G_g, source.G_g_plus
         if mask is not None:
             G_g.diagonalScale(None, mask)
@@ -367,9 +375,7 @@ class CurrentSurfaceGap(GapSourceBase):
         W = self._lumped_weights(surface)
         source = self._gap(u_nodes, W, surface)
         g = source.g
-        if source.covered_weights is not None:
-            W = np.where(source.covered_weights > 0, source.covered_weights, W)
-        W = safe_weights(W)
+        W = safe_weights(source.lumped_weights(W)[0])
         n = self.slave.layout.num_owned
         local = np.sum(self.law.energy(g, W)[:n])
         return float(self.slave.layout.comm.allreduce(local))

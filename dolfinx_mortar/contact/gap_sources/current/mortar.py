@@ -29,7 +29,7 @@ from dolfinx_mortar.contact.gap_sources.current.covered_assembly import (covered
                                                                           covered_hessian)
 from dolfinx_mortar.contact.gap_sources.current.finite_deformation import CurrentSurfaceGap, SourceGaps
 from dolfinx_mortar.contact.laws import PenaltyLaw, safe_weights
-from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind
+from dolfinx_mortar.kinds import BasisKind
 from dolfinx_mortar.layout import assemble_blocks, assemble_global_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling, polynomial_degree, segment_quadrature
 from dolfinx_mortar.mortar.pair_share import DealtPairs, deal_evenly, own_pairs
@@ -97,9 +97,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
             raise ValueError("slave and master must share one displacement space (one mesh)")
         super().__init__(slave, kind, law)
         self.master, self.search_radius = master, search_radius
-        if boundary_modification and not (kind in DUAL_KINDS and not self.pointwise):
-            raise ValueError("the boundary modification applies to the dual kinds (LcLS*, "
-                             "LcLS) with the nodal active set")
+        #: validated with the options (ContactOptions.of): dual kinds, nodal set
         self.boundary_modification = boundary_modification
         #: the slave surface is its own master (pairs without a facet's neighbours)
         self.self_contact = master is slave
