@@ -37,8 +37,7 @@ def current_model(options: ContactOptions, slave: LagrangeSurface,
     if obstacle is not None:
         model = CurrentObstacleGap(slave, obstacle, options.kind, options.law)
     elif options.self_contact:
-        model = CurrentSelfContactGap(slave, options.kind, options.law, options.search_radius,
-                                      options.boundary_modification)
+        model = CurrentSelfContactGap(slave, options.kind, options.law, options.search_radius)
     else:
         model = CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius,
                                  options.boundary_modification)
@@ -107,8 +106,8 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     it (self-contact, where it is refused, or turned off). Its nodal gaps are
     compared here, where the term is made, with the modified ones of the
     frozen model: a node that only the current surface sees penetrating stops
-    the construction, with the way out. A master that covers the slave's elements in full (a cylinder on a
-    wider block) passes. Returns the frozen model's coupling where it was made
+    the construction, with the way out. A master that covers the slave's
+    elements in full (a cylinder on a wider block) passes. Returns the frozen model's coupling where it was made
     (None elsewhere), for the term's other checks.
     """
     if not (master is not None and options.kind in DUAL_KINDS and not options.law.pointwise

@@ -37,6 +37,8 @@ class CoveredPairs:
     dual: CoveredDual
     quantities: NodeLayout
     Q: PETSc.Mat
+    #: global dofs of the variables of the kept pairs dealt to this rank (the pattern)
+    dofs: IntArray
 
     @property
     def pairs(self) -> IntArray:
@@ -87,7 +89,7 @@ def covered_gap(source, coupling: MortarCoupling, W: FloatArray,
         "paf,pfn->pan", O_rows.reshape(n, ns, nf), grad), cols=source.dofs)
     Q = assemble_global_blocks(quantities, q_rows.reshape(n, nf).astype(np.int64), dofs,
                                grad, cols=source.dofs)
-    data = CoveredPairs(coupling, pair_cells, kept, dual, quantities, Q)
+    data = CoveredPairs(coupling, pair_cells, kept, dual, quantities, Q, dofs)
     return SourceGaps(g, G_g, layout.on_cells(slave.cells[pair_cells]), data=data,
                       coefficients=dual.coefficients(source.C), covered_weights=W_cov,
                       G_covered_weights=G_W)
@@ -98,33 +100,33 @@ def covered_hessian(source, data: CoveredPairs, Fg: Optional[FloatArray],
     """``Σ_A F_g,A ∂²ĝ_A + F_W,A ∂²W_A`` over the covered part: the pairs' own
     second derivatives of c and L, weighted, plus ``Qᵀ B Q`` (``Fg=None``: every
     entry it may have)."""
-    slave = source.slave
-    cells_nodes = slave.cells
+    cells_nodes = source.slave.cells
     dual, nf = data.dual, data.dual.num_functions
-    nc = len(cells_nodes)
     if Fg is None:
-        F = np.ones((nc, cells_nodes.shape[1]))
-        FWc = F
+        # the pattern: each kept pair's variables couple with each other, and the
+        # quantities of every rebuilt cell with each other
+        width = data.dofs.shape[1]
+        H = assemble_global_blocks(source.dofs, data.dofs, data.dofs,
+                                   np.zeros((len(data.dofs), width, width)))
+        rebuilt = np.flatnonzero(dual.covered & ~dual.sliver)
+        B = np.ones((len(rebuilt), nf, nf))
     else:
         F, FWc = Fg[cells_nodes], FW[cells_nodes]
-    weights = dual.pair_weights(F, FWc)
-    # a pair adds nothing where no node of its cell has F_g or F_W ≠ 0 (the
-    # positive part's own zero: see CurrentMortarGap._gap_hessian)
-    active = np.any((F != 0.0) | (FWc != 0.0), axis=1)
-    which = data.kept & active[data.pair_cells]
-    dealt = deal_evenly(data.coupling, which, weights[data.pair_cells[which]])
-    r = source.dealt_pair_derivatives(dealt, data.coupling.zero_length, with_hessian=True,
-                                      node_weights=dealt.values[0], with_mass=True)
-    n = len(dealt.pairs)
-    dofs = source._variable_dofs(r.nodes, n)
-    nv = dofs.shape[1]
-    blocks = r.hessian.reshape(n, nv, nv)
-    if Fg is None:
-        blocks = np.zeros_like(blocks)
-    H = assemble_global_blocks(source.dofs, dofs, dofs, blocks)
+        weights = dual.pair_weights(F, FWc)
+        # a pair adds nothing where no node of its cell has F_g or F_W ≠ 0 (the
+        # positive part's own zero: see CurrentMortarGap._gap_hessian)
+        active = np.any((F != 0.0) | (FWc != 0.0), axis=1)
+        which = data.kept & active[data.pair_cells]
+        dealt = deal_evenly(data.coupling, which, weights[data.pair_cells[which]])
+        r = source.dealt_pair_derivatives(dealt, data.coupling.zero_length, with_hessian=True,
+                                          node_weights=dealt.values[0], with_mass=True)
+        n = len(dealt.pairs)
+        dofs = source._variable_dofs(r.nodes, n)
+        nv = dofs.shape[1]
+        H = assemble_global_blocks(source.dofs, dofs, dofs, r.hessian.reshape(n, nv, nv))
+        rebuilt = np.flatnonzero(active & dual.covered & ~dual.sliver)
+        B = dual.cross_blocks(F)[rebuilt]
     # products of first derivatives of one cell's pairs: Qᵀ B Q
-    rebuilt = np.flatnonzero(active & dual.covered & ~dual.sliver)
-    B = dual.cross_blocks(F)[rebuilt] if Fg is not None else np.ones((len(rebuilt), nf, nf))
     rows = _quantity_rows(data.quantities, rebuilt, nf)
     B_mat = assemble_global_blocks(data.quantities, rows, rows, B, cols=data.quantities)
     BQ = B_mat.matMult(data.Q)

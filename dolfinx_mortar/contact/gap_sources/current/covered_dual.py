@@ -29,6 +29,7 @@ positive functions N there (C = I, ĝ = c), of the sliver's size.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
@@ -76,8 +77,10 @@ class CoveredDual:
         nd = self.c.shape[1]
         return nd + nd * nd
 
+    @cached_property
     def _dual(self):
-        """W, L⁻¹ and z = L⁻¹c of the rebuilt cells (identity and c on the others)."""
+        """W, L⁻¹ and z = L⁻¹c of the rebuilt cells (identity and c on the others),
+        and which cells are rebuilt: inverted once, asked by every method below."""
         nc, nd = self.c.shape
         W = self.L.sum(axis=2)
         Linv = np.broadcast_to(np.eye(nd), (nc, nd, nd)).copy()
@@ -88,14 +91,14 @@ class CoveredDual:
 
     def gaps(self) -> tuple[FloatArray, FloatArray]:
         """Per cell: ``ĝ_a`` and ``W_a = ∫_cov N_a``, (cells, nd) each."""
-        W, _, z, dual = self._dual()
+        W, _, z, dual = self._dual
         g = np.where(dual[:, None], W * z, self.c)
         return g, W
 
     def coefficients(self, reference: FloatArray) -> FloatArray:
         """C of every cell (``reference`` where nothing is covered), (cells, nd, nd)."""
         nc, nd = self.c.shape
-        W, Linv, _, dual = self._dual()
+        W, Linv, _, dual = self._dual
         C = np.broadcast_to(reference, (nc, nd, nd)).copy()
         C[dual] = Linv[dual] * W[dual][:, None, :]             # L⁻¹ diag(W)
         C[self.sliver] = np.eye(nd)
@@ -105,7 +108,7 @@ class CoveredDual:
         """The coefficients of ĝ's and W's gradients in the kernel's functions,
         (cells, nd, nd + nd²) each: ``dĝ_a = Σ_f Γ_af dq_f``, ``dW_a = Σ_f Ω_af dq_f``."""
         nc, nd = self.c.shape
-        W, Linv, z, dual = self._dual()
+        W, Linv, z, dual = self._dual
         eye = np.eye(nd)
         Omega = np.zeros((nc, nd, self.num_functions))
         Omega[:, :, nd:] = np.repeat(eye[:, :, None], nd, axis=2).reshape(nd, nd * nd)
@@ -125,7 +128,7 @@ class CoveredDual:
         ``Σ_a F_a ∂²ĝ_a + F_W,a ∂²W_a`` that come from c's and L's own second
         derivatives, (cells, nd + nd²). ``F``, ``FW``: (cells, nd) at the cells' nodes."""
         nc, nd = self.c.shape
-        W, Linv, z, dual = self._dual()
+        W, Linv, z, dual = self._dual
         lam = np.zeros((nc, self.num_functions))
         # ∂²W_a = Σ_c ∂²L_ac, weighted F_W,a, and F_a z_a where ĝ = W∘z
         row = FW + np.where(dual[:, None], F * z, 0.0)
@@ -142,7 +145,7 @@ class CoveredDual:
         sliver cells (ĝ = c is linear in q there)."""
         nc, nd = self.c.shape
         nf = self.num_functions
-        W, Linv, z, dual = self._dual()
+        W, Linv, z, dual = self._dual
         eye = np.eye(nd)
         U = np.zeros((nd, nf))                                  # dW_a = Σ_c dL_ac
         U[:, nd:] = np.repeat(eye[:, :, None], nd, axis=2).reshape(nd, nd * nd)

@@ -129,9 +129,6 @@ class CurrentState:
     #: pointwise active set: y⁺ = ĝ⁺ W^{−k} with ĝ⁺_A = ∫ φ_A ⟨d⟩ da, and ∂y⁺/∂u
     y_plus: Optional[FloatArray] = None
     G_y_plus: Optional[PETSc.Mat] = None
-    #: ``W_A = ∫ N_A`` over the whole current surface (W: over the covered part, where
-    #: the basis is rebuilt over it)
-    W_whole: Optional[FloatArray] = None
 
 
 class CurrentSurfaceGap(GapSourceBase):
@@ -298,7 +295,6 @@ class CurrentSurfaceGap(GapSourceBase):
         W = self._lumped_weights(surface)
         G_W = assemble_blocks(layout, cells, self.dofs, self.cell_dofs, surface.W_gradient)
         source = self._gap(u_nodes, W, surface)
-        W_whole = W
         W, from_cells = source.lumped_weights(W, G_W, layout)
         g, G_g, G_g_plus = source.g, source.G_g, source.G_g_plus
         if mask is not None:
@@ -326,7 +322,7 @@ class CurrentSurfaceGap(GapSourceBase):
         coefficients = law.nodal_gaps(C, Wsafe[cells][:, None, :])
         return CurrentState(g, W, y, G_g, G_W, G_y, residual, Fg, FW, FW * from_cells, x,
                             obstacle, source, law.weights(Wsafe), coefficients, y_plus,
-                            G_y_plus, W_whole)
+                            G_y_plus)
 
     def _nodal_gap_derivative(self, G_g: PETSc.Mat, G_W: PETSc.Mat, y: FloatArray,
                               Wsafe: FloatArray) -> PETSc.Mat:

@@ -59,13 +59,12 @@ class CurrentSelfContactGap(TwoPassPressures, CurrentMortarGap):
     the slave surface as its own master)."""
 
     def __init__(self, surface: LagrangeSurface, kind: BasisKind, law: PenaltyLaw,
-                 search_radius: Optional[float] = None, boundary_modification: bool = False):
-        super().__init__(surface, surface, kind, half_penalty(law), search_radius,
-                         boundary_modification)
+                 search_radius: Optional[float] = None):
+        # no boundary modification: refused in self-contact here (ContactOptions.of)
+        super().__init__(surface, surface, kind, half_penalty(law), search_radius)
 
     def _node_geometry(self, state: ContactState) -> tuple[FloatArray, FloatArray]:
         """The averaged nodal normals and ``W_A`` of the current surface at ``state``."""
         x = np.zeros((self.slave.layout.size_local, self.slave.gdim))
         x[self.slave.cells] = state.data.x
-        # W_A = ∫ N_A of the whole surface, as the frozen bases' (not the covered part's)
-        return averaged_nodal_normals(self.slave, x), state.data.W_whole
+        return averaged_nodal_normals(self.slave, x), state.lumped_weights
