@@ -137,7 +137,7 @@ class LoadPathSolver:
         chosen = key in self.petsc_options or self._user_options.get(key, False)
         self.line_search = None if chosen else self.problem.line_search
         if self.line_search is not None:
-            self.line_search.attach(snes)
+            self.line_search.attach(snes, round_off=self._equilibrium.floor)
         return snes
 
     def _matrix(self, new: bool = False) -> PETSc.Mat:

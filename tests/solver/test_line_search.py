@@ -14,6 +14,7 @@ from support import load_demo
 from support.meshes import rectangle
 
 from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidSphere
+from dolfinx_mortar.solver.newton import EquilibriumTest
 from dolfinx_mortar.solver.newton.line_search import FullStepFirst, l2_step_length
 
 BOTTOM, TOP, LEFT = 1, 2, 3
@@ -171,6 +172,55 @@ def test_a_step_to_a_residual_that_is_not_finite_is_halved_until_it_is(shorten):
     assert line_search.halved_steps == 1 and problem.offers == 1
     xs = iterates(snes, x1, 4)
     assert abs(xs[-1][0] - 1.0) < 1e-12
+
+
+class KinkProblem(ArctanProblem):
+    """A node held open a hair from contact: ``F₀ = x₀ − 1 + ε⟨x₀⟩`` (the
+    bulk pushes it onto a penalty ε = 1e10), ``F₁ = x₁ − 1`` a dof that only
+    the full step puts right, and ``F₂ = x₂ − 1`` keeps ‖x‖ at the scale 1.
+    From x = (−1e-9, 0, 1) the Jacobian has no contact stiffness, the Newton
+    step takes the node 1 deep, and ‖F‖ along it is least at the kink."""
+
+    PENALTY = 1e10
+
+    def evaluate(self, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        x0, x1, x2 = x.array_r
+        b.array[:] = [x0 - 1.0 + self.PENALTY * max(x0, 0.0), x1 - 1.0, x2 - 1.0]
+
+    def derivative(self, x: np.ndarray) -> np.ndarray:
+        return np.array([1.0 + self.PENALTY * (x[0] >= 0), 1.0, 1.0])
+
+
+def test_a_step_stalled_at_a_kink_is_taken_whole():
+    """Where ``l2`` shortens the step to round-off (``‖Δx‖ ≤ stol·‖x‖``) while
+    ‖F‖ is not, the full step is taken uphill (``kink_steps``): the next
+    Jacobian sees the penalty and Newton lands on the root. Without it, the
+    library's convergence test stops the solve ("Newton step at round-off")
+    and PETSc's own calls it converged, with ‖F‖ = 1."""
+    start, newton = np.array([-1e-9, 0.0, 1.0]), np.ones(3)
+    norms = []
+    for step in (0.0, 0.5, 1.0):
+        b = PETSc.Vec().createSeq(3, comm=PETSc.COMM_SELF)
+        KinkProblem(3).evaluate(PETSc.Vec().createWithArray(start + step * (newton - start),
+                                                            comm=PETSc.COMM_SELF), b)
+        norms.append(b.norm() ** 2)
+    stol = 1e-8     # PETSc's default
+    assert l2_step_length(*norms) * np.linalg.norm(newton - start) < stol
+
+    problem = KinkProblem(3)
+    snes = problem.snes("basic")
+    # the library's test (PETSc's own stops where ‖F‖ rises 1e4-fold)
+    test = EquilibriumTest()
+    snes.setConvergenceTest(test)
+    problem.line_search = line_search = FullStepFirst(problem)
+    line_search.attach(snes, round_off=test.floor)
+    x = PETSc.Vec().createWithArray(start.copy(), comm=PETSc.COMM_SELF)
+    snes.solve(None, x)
+    assert snes.getConvergedReason() in (PETSc.SNES.ConvergedReason.CONVERGED_FNORM_RELATIVE,
+                                         PETSc.SNES.ConvergedReason.CONVERGED_FNORM_ABS)
+    assert x.array_r[0] == pytest.approx(1.0 / (1.0 + KinkProblem.PENALTY), rel=1e-8)
+    assert x.array_r[1] == pytest.approx(1.0, rel=1e-12)
+    assert line_search.kink_steps == 1
 
 
 class CountingContactTerm(ContactTerm):

@@ -139,7 +139,7 @@ class EquilibriumTest:
                               f"{self.window} iterations ({band[0]:.3e} to {band[-1]:.3e})")
                 accepted = _SNES.CONVERGED_ITS
             period = self._period()
-            if stagnation is None and period and max(self.norms[-period:]) <= self._floor():
+            if stagnation is None and period and max(self.norms[-period:]) <= self.floor():
                 # a cycle in the last digits: the residual is round-off
                 return _SNES.CONVERGED_ITS
             if stagnation is None and period:
@@ -151,7 +151,7 @@ class EquilibriumTest:
             # the floor of double precision is the whole problem's: a step
             # whose increment is small (a tangential load after the normal
             # one) stagnates at round-off of the forces already carried
-            if fnorm <= self._floor():
+            if fnorm <= self.floor():
                 return accepted
             self.cause = (f"{stagnation}, |R| = {fnorm:.3e} = {self._relative(fnorm)} of the "
                           f"reference force {self.reference:.3e} (accepted: {self.floor_rtol:g} "
@@ -160,7 +160,7 @@ class EquilibriumTest:
                           "Newton cannot reduce the residual further (a cycling active set, "
                           "or an ill-conditioned Newton matrix, e.g. a penalty far above E/h)")
             return _SNES.DIVERGED_DTOL
-        if its >= max_it and max(self.norms[-self.window:]) <= self._floor():
+        if its >= max_it and max(self.norms[-self.window:]) <= self.floor():
             # the last iterations wandered in round-off: nothing left to reduce
             return _SNES.CONVERGED_ITS
         if its >= max_it:
@@ -170,7 +170,7 @@ class EquilibriumTest:
             return _SNES.DIVERGED_MAX_IT
         return _SNES.CONVERGED_ITERATING
 
-    def _floor(self) -> float:
+    def floor(self) -> float:
         """The residual that double precision cannot go below here: ``floor_rtol``
         times the step's force, the path's largest, or the contact forces carried."""
         return self.floor_rtol * max(self.reference, self.force_scale, self.carried)
