@@ -6,8 +6,11 @@ down (plane strain, small-strain elasticity in UFL, the left edges on a symmetry
 term holds the ground contact; ONE self-contact term holds both interfaces between the blocks,
 given as the list of their four faces' tags: nobody says which face is slave or master, and
 the pairs between the blocks are found by the search (docs/SELF_CONTACT.md). Every interface
-carries the uniform pressure q, to round-off (a patch test). Run:
-``python3 demos/stack_one_term.py [--json F]`` (or with ``mpirun -n 2``).
+carries the uniform pressure q, to round-off (a patch test); with
+``--configuration current`` the pressure on the deformed faces, q/(1 + ν(1 + ν)q/E) (the
+blocks widen). Run:
+``python3 demos/stack_one_term.py [--kind K] [--configuration C] [--steps N] [--json F]``
+(or with ``mpirun -n 2``).
 """
 import argparse
 import json
@@ -31,6 +34,10 @@ q = 0.01                     # the traction on the top block's top face
 
 def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--kind", default="LcLS*", help="mortar basis kind (LcLS*)")
+    parser.add_argument("--configuration", default="initial",
+                        help="basis_configuration of both terms (initial)")
+    parser.add_argument("--steps", type=int, default=1, help="load steps (1)")
     parser.add_argument("--json", help="write the figures to this file")
     args = parser.parse_args(argv)
     comm = MPI.COMM_WORLD
@@ -39,16 +46,23 @@ def main(argv=None) -> dict:
     u, v = fem.Function(V, name="u"), ufl.TestFunction(V)
     E = 1.0
     ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
-    F = linear_elastic_residual(u, E, 0.3) + q * v[1] * ds(TOP[2])
+    load = fem.Constant(mesh, 0.0)     # q at the end of the load path
+    F = linear_elastic_residual(u, E, 0.3) + load * v[1] * ds(TOP[2])
     left = fem.locate_dofs_topological(V.sub(0), 1, facet_tags.find(LEFT))
     bcs = [fem.dirichletbc(0.0, left, V.sub(0))]
     penalty = 1e3 * E / 0.03
+    options = {"kind": args.kind, "penalty": penalty,
+               "basis_configuration": args.configuration}
     ground = ContactTerm(u, facet_tags, BOTTOM[0], obstacle=RigidPlane([0, 0], [0, 1]),
-                         kind="LcLS*", penalty=penalty, name="ground")
+                         name="ground", **options)
     interfaces = ContactTerm(u, facet_tags, [TOP[0], BOTTOM[1], TOP[1], BOTTOM[2]],
-                             self_contact=True, kind="LcLS*", penalty=penalty, name="blocks")
+                             self_contact=True, name="blocks", **options)
     problem = NonlinearContactProblem(F, u, [ground, interfaces], bcs)
-    result = LoadPathSolver(problem).solve(lambda t: None, load_steps=1)
+
+    def ramp(t: float) -> None:
+        load.value = t * q
+
+    result = LoadPathSolver(problem).solve(ramp, load_steps=args.steps)
     pressures = interfaces.results.surface_pressure(gather=True)
     on_faces = pressures.x[:, 1] > 0.0                 # every node of the four faces
     figures = {

@@ -125,6 +125,13 @@ class MortarCoupling:
     deal_segmentation
         Segment all ranks' candidates in equal shares and return the pairs to
         their slave facets' ranks (:mod:`~dolfinx_mortar.mortar.dealt_segmentation`).
+    keep_slivers
+        Keep overlaps of any positive width, not only those wider than
+        :attr:`zero_length`: the current configuration, whose exact
+        derivatives need every sliver. A sliver's integrals are round-off, but
+        the derivative of its width is the integrand at its ends; dropped, the
+        gradient jumped by that much where a node of one side came within the
+        zero length of a node of the other.
 
     Raises
     ------
@@ -142,7 +149,8 @@ class MortarCoupling:
                  opposing_normals_only: bool = True, keep_points: bool = False,
                  facet_search_factor: Optional[float] = None,
                  interface_normals: bool = False, self_contact: bool = False,
-                 whole_master: bool = False, deal_segmentation: bool = False):
+                 whole_master: bool = False, deal_segmentation: bool = False,
+                 keep_slivers: bool = False):
         if slave.gdim != master.gdim:
             raise ValueError(f"slave ({slave.gdim}D) and master ({master.gdim}D) surfaces "
                              "live in different dimensions")
@@ -200,7 +208,7 @@ class MortarCoupling:
         self.zero_length = zero_length(self.length_scale)
         def segment(normals: FloatArray, keep: bool, along_normals: bool):
             kernel = segmenter(slave, master, points, weights, opposing_normals_only,
-                               self.length_scale, along_normals)
+                               self.length_scale, along_normals, keep_slivers)
             if deal_segmentation and comm.size > 1:
                 dealt = dealt_segmentation(comm, kernel, xs, slave_cells, normals, master_copy,
                                            candidates, keep)

@@ -58,15 +58,16 @@ class Segmentation:
 
 def segmenter(slave, master, points: FloatArray, weights: FloatArray,
               opposing_normals_only: bool, length_scale: float,
-              along_normals: bool) -> Segment:
+              along_normals: bool, keep_slivers: bool = False) -> Segment:
     """The kernel's segmentation of the ``slave`` and ``master`` surfaces' facet
-    types with these settings, of any of their cells."""
+    types with these settings, of any of their cells (``keep_slivers``: see
+    :class:`~dolfinx_mortar.mortar.coupling.MortarCoupling`)."""
     def segment(xs, cells, normals, master_x, master_cells, candidates, keep_points):
         return _kernels.mortar_integrals(
             slave.facet_type, xs, cells, normals, master.facet_type, master_x, master_cells,
             candidates, points, weights, opposing_normals_only, length_scale=length_scale,
             keep_points=keep_points, axisymmetric=slave.axisymmetric,
-            project_along_normals=along_normals)
+            project_along_normals=along_normals, keep_slivers=keep_slivers)
     return segment
 
 

@@ -154,15 +154,14 @@ bind_segmentation(py::module_& m)
        double length_scale,
        bool keep_points,
        bool axisymmetric,
-       bool project_along_normals)
+       bool project_along_normals,
+       bool keep_slivers)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
-      const SegmentationOptions options{ opposing_normals_only,
-                                         length_scale,
-                                         keep_points,
-                                         axisymmetric,
-                                         project_along_normals };
+      const SegmentationOptions options{ opposing_normals_only, length_scale,
+                                         keep_points,           axisymmetric,
+                                         project_along_normals, keep_slivers };
       py::gil_scoped_release release;
       return mortar_integrals(
         slave,
@@ -188,6 +187,7 @@ bind_segmentation(py::module_& m)
     py::arg("keep_points") = false,
     py::arg("axisymmetric") = false,
     py::arg("project_along_normals") = false,
+    py::arg("keep_slivers") = false,
     "Segmentation and slave-basis mortar integrals per cell pair");
 
   using PG = PairGapDerivatives;
@@ -271,7 +271,8 @@ bind_segmentation(py::module_& m)
        bool with_positive_part,
        bool axisymmetric,
        std::optional<array_t> node_weights,
-       bool with_mass)
+       bool with_mass,
+       bool keep_slivers)
     {
       auto slave = surface_view(slave_type, xs, cs);
       auto master = surface_view(master_type, xm, cm);
@@ -284,7 +285,8 @@ bind_segmentation(py::module_& m)
                                     axisymmetric,
                                     node_weights ? as_span(*node_weights)
                                                  : std::span<const double>(),
-                                    with_mass };
+                                    with_mass,
+                                    keep_slivers };
       py::gil_scoped_release release;
       return current_pair_gaps(
         slave,
@@ -312,6 +314,7 @@ bind_segmentation(py::module_& m)
     py::arg("axisymmetric") = false,
     py::arg("node_weights") = py::none(),
     py::arg("with_mass") = false,
+    py::arg("keep_slivers") = false,
     "Current-configuration mortar gaps of cell pairs with exact gradients and "
     "Hessians "
     "(and, with_positive_part, the pointwise active set's integrals of <d> "

@@ -129,7 +129,8 @@ current_pair_gaps(const FacetSurface& slave,
               with_positive_part,
               axisymmetric,
               node_weights,
-              with_mass] = options;
+              with_mass,
+              keep_slivers] = options;
   check_input(slave, slave_ids, master, master_ids, pairs, options);
   const int gdim = slave.gdim;
   const int ns = facet_num_nodes(slave.type), nm = facet_num_nodes(master.type);
@@ -211,6 +212,7 @@ current_pair_gaps(const FacetSurface& slave,
                                     points,
                                     weights,
                                     zero,
+                                    keep_slivers,
                                     opposing_normals_only,
                                     axisymmetric,
                                     with_mass,

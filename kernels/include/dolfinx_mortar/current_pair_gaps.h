@@ -99,6 +99,9 @@ struct PairGapOptions
   /// the ns c_A, row-major: functions ns + ns²), which a dual basis rebuilt
   /// over the covered part needs; node_weights then has ns + ns² per pair
   bool with_mass = false;
+  /// Integrate overlaps of any positive width (SegmentationOptions::
+  /// keep_slivers, which the pairs' segmentation must share)
+  bool keep_slivers = false;
 };
 
 /// c_A and its derivatives for every pair: integrate_pieces instantiated with

@@ -63,6 +63,10 @@ struct SegmentationOptions
   /// not the slave's own, such as interface normals). A piece whose
   /// interpolated normal is within 60° of its plane keeps its own normal.
   bool project_along_normals = false;
+  /// Keep overlaps of any positive width, not only those wider than the
+  /// zero length (overlap_of): the current configuration, whose derivatives
+  /// need every sliver the Jets of current_pair_gaps integrate
+  bool keep_slivers = false;
 };
 
 /// Segment candidate slave–master cell pairs and integrate on the segments.

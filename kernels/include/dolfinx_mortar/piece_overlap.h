@@ -61,12 +61,19 @@ struct Overlap
 /// The overlap of two polygons in the slave piece's plane coordinates: an
 /// interval in 2D, a clipped convex polygon fanned from its centroid in 3D.
 /// @param[in] master_polygon Taken by value: it may be turned around
+/// @param[in] zero The zero length of the geometric decisions
+/// @param[in] keep_slivers Keep an overlap of any positive width, not only
+/// one wider than @p zero (the current configuration: a sliver's integral is
+/// round-off, but its derivative is the integrand at its ends, as large as a
+/// whole segment's; dropped, the gradient jumped by that much where a node
+/// of one side came within @p zero of a node of the other)
 template<Scalar G>
 Overlap<G>
 overlap_of(int gdim,
            const std::vector<std::array<G, 2>>& slave_polygon,
            std::vector<std::array<G, 2>> master_polygon,
-           double zero)
+           double zero,
+           bool keep_slivers = false)
 {
   using P2 = std::array<G, 2>;
   Overlap<G> out;
@@ -77,7 +84,7 @@ overlap_of(int gdim,
     const G hi = smaller(slave_polygon[1][0],
                          larger(master_polygon[0][0], master_polygon[1][0]));
     const G length = hi - lo;
-    if (value(length) > zero)
+    if (value(length) > (keep_slivers ? 0.0 : zero))
     {
       out.vertices = { { lo, 0.0 }, { hi, 0.0 } };
       out.cells.push_back(
@@ -91,16 +98,21 @@ overlap_of(int gdim,
   // its area is not round-off. Boxes more than twice the zero length apart
   // cannot overlap by more than the clipping's tolerance: the rejection the
   // clipping would reach, at a fraction of its cost (most candidates end
-  // here).
-  if (boxes_apart(slave_polygon, master_polygon, 2 * zero))
+  // here). Keeping slivers, every decision is exact: with the tolerance, a
+  // vertex within the zero length outside a clip edge is kept as on it, and
+  // the overlap then follows that vertex instead of the crossing point, so
+  // its derivative jumped where a vertex entered the band.
+  const double tolerance = keep_slivers ? 0.0 : zero;
+  if (boxes_apart(slave_polygon, master_polygon, 2 * tolerance))
     return out;
   if (value(signed_area(master_polygon)) < 0)
     std::reverse(master_polygon.begin(), master_polygon.end());
-  const auto clipped = clip_polygon(slave_polygon, master_polygon, zero);
+  const auto clipped = clip_polygon(slave_polygon, master_polygon, tolerance);
   // an overlap no wider than the zero length is a segment or a point
   // (touching edges, a shared vertex)
   if (clipped.size() < 3 or
-      !(2 * value(signed_area(clipped)) > zero * longest_edge(clipped)))
+      !(2 * value(signed_area(clipped)) >
+        (keep_slivers ? 0.0 : zero * longest_edge(clipped))))
     return out;
   const double m = static_cast<double>(clipped.size());
   P2 g = { 0.0, 0.0 };

@@ -285,6 +285,8 @@ private:
 /// @param[in] slave_pieces, master_pieces cell_pieces of the same nodes: a
 /// caller that meets a cell in many pairs builds them once
 /// @param[in] zero The zero length of every geometric decision
+/// @param[in] keep_slivers Integrate overlaps of any positive width (see
+/// overlap_of)
 /// @param[in] with_master_N Give the callback the master's shape
 /// functions (else SegmentPoint::master_N is empty)
 /// @param[in] lift G → T (the identity for values)
@@ -309,6 +311,7 @@ integrate_pieces(FacetType slave_type,
                  std::span<const double> points,
                  std::span<const double> weights,
                  double zero,
+                 bool keep_slivers,
                  bool opposing_normals_only,
                  bool axisymmetric,
                  bool with_master_N,
@@ -356,8 +359,8 @@ integrate_pieces(FacetType slave_type,
       std::vector<P2> master_polygon;
       for (const Vec3<G>& x : mf.polygon)
         master_polygon.push_back(sf.plane_coordinates(x));
-      const Overlap<G> overlap =
-        overlap_of<G>(gdim, slave_polygon, std::move(master_polygon), zero);
+      const Overlap<G> overlap = overlap_of<G>(
+        gdim, slave_polygon, std::move(master_polygon), zero, keep_slivers);
       if (overlap.cells.empty())
         continue;
       if (!flat)

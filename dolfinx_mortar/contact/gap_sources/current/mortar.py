@@ -136,7 +136,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
         return dealt.gap_jets(self.segment_points, self.segment_weights, zero_length,
                               with_hessian=with_hessian, with_positive_part=with_positive_part,
                               axisymmetric=self.slave.axisymmetric, node_weights=node_weights,
-                              with_mass=with_mass)
+                              with_mass=with_mass, keep_slivers=True)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, W: FloatArray,
@@ -153,7 +153,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
                                                        if self.search_radius is None
                                                        else None),
                                   keep_points=self.pointwise, self_contact=self.self_contact,
-                                  deal_segmentation=True)
+                                  deal_segmentation=True, keep_slivers=True)
         if self.boundary_modification:
             return covered_gap(self, coupling, W, surface.W)
         all_cells = slave.cells[coupling.pairs[:, 0]]
