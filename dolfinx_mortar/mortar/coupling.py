@@ -93,10 +93,8 @@ class MortarCoupling:
     facet_search_factor
         Instead of one ``search_radius``, pair each slave facet with the master
         facets within this multiple of its own diameter. On a graded mesh the
-        largest facet sets the default radius for all: on Hertz 3D at 52k
-        dofs it made 812k candidates for 6.9k pairs (0.70 s of segmentation),
-        against 70k candidates with a factor of 2 (the same pairs wherever
-        the surfaces are closer than two local element lengths).
+        largest facet sets the default radius for all (Hertz 3D, 52k dofs: 812k
+        candidates for 6.9k pairs, against 70k with a factor of 2).
     quadrature_degree
         Degree of the rule on each segment; the default integrates the
         products of slave and master functions exactly on affine facets
@@ -106,8 +104,8 @@ class MortarCoupling:
     opposing_normals_only
         Skip master facets that face the same way as the slave facet.
     keep_points
-        Also keep every segment quadrature point (weight, gap, normal, slave
-        and master basis values) in :attr:`points`, for the pointwise active set.
+        Also keep every segment quadrature point (weight, gap, normal, basis
+        values) in :attr:`points`, for the pointwise active set.
     interface_normals
         Measure gaps along the bisector of the slave normal and the opposite
         master normal instead of the slave normal alone
@@ -118,20 +116,14 @@ class MortarCoupling:
         that are neighbours on the surface are never candidates
         (:func:`~dolfinx_mortar.mortar.facet_search.near_in_surface`).
     whole_master
-        Gather every rank's master facets on every rank, instead of only those
-        the slave facets' search boxes meet, with a band of the largest master
-        facet (:class:`~dolfinx_mortar.mortar.surface_exchange.NearSurface`):
-        for comparisons.
+        Gather every rank's master facets on every rank (for comparisons), not
+        only those the slave facets' search boxes meet, with a band (:class:`NearSurface`).
     deal_segmentation
         Segment all ranks' candidates in equal shares and return the pairs to
         their slave facets' ranks (:mod:`~dolfinx_mortar.mortar.dealt_segmentation`).
     keep_slivers
         Keep overlaps of any positive width, not only those wider than
-        :attr:`zero_length`: the current configuration, whose exact
-        derivatives need every sliver. A sliver's integrals are round-off, but
-        the derivative of its width is the integrand at its ends; dropped, the
-        gradient jumped by that much where a node of one side came within the
-        zero length of a node of the other.
+        :attr:`zero_length` (the current configuration; docs/DESIGN.md, §Tolerances).
 
     Raises
     ------

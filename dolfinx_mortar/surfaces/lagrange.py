@@ -398,4 +398,3 @@ class LagrangeSurface:
         cells = np.asarray(cells, dtype=np.int64)
         N, _, _ = self.tabulate_at(cells, X)
         return cells, N
-

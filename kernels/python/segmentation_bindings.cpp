@@ -1,9 +1,8 @@
 // Copyright (C) 2026 dolfinx_mortar developers
 // SPDX-License-Identifier: MIT
 //
-// Bindings of the segmentation (mortar integrals per pair, with their points)
-// and of the current configuration's pair gaps with their derivatives: numpy
-// views in, typed results out (numpy arrays as read-only properties).
+// Bindings of the segmentation (mortar integrals per pair and their points) and
+// of the current pair gaps with derivatives: numpy views in, typed results out.
 #include "bindings.h"
 
 #include <dolfinx_mortar/current_pair_gaps.h>
@@ -316,13 +315,11 @@ bind_segmentation(py::module_& m)
     py::arg("with_mass") = false,
     py::arg("keep_slivers") = false,
     "Current-configuration mortar gaps of cell pairs with exact gradients and "
-    "Hessians "
-    "(and, with_positive_part, the pointwise active set's integrals of <d> "
-    "with their "
-    "gradients); with node_weights (pairs, ns), those of the one function "
-    "sum_A w_A c_A "
-    "per pair instead; with_mass, also the covered mass L_AB = int N_A N_B "
-    "(ns^2 functions after the ns c_A; node_weights then (pairs, ns + ns^2))");
+    "Hessians (and, with_positive_part, the pointwise active set's integrals "
+    "of <d> with their gradients); with node_weights (pairs, ns), those of the "
+    "one function sum_A w_A c_A per pair instead; with_mass, also the covered "
+    "mass L_AB = int N_A N_B (ns^2 functions after the ns c_A; node_weights "
+    "then (pairs, ns + ns^2)); keep_slivers: overlaps of any width count");
 
   using ND = NormalDerivatives;
   py::class_<ND>(
