@@ -233,11 +233,17 @@ class FullStepFirst:
                 self.full_steps += halvings == 0
                 self.offer(point, residual)
                 return halvings > 0
-            f_mid = self._squared_norm_at(x, y, 0.5, point, residual)
+            # the midpoint in vectors of its own: an uphill full step (below)
+            # offers the full step's residual, evaluated once
+            mid_point, mid_residual = point.duplicate(), residual.duplicate()
+            try:
+                f_mid = self._squared_norm_at(x, y, 0.5, mid_point, mid_residual)
+            finally:
+                mid_point.destroy()
+                mid_residual.destroy()
             step = l2_step_length(f0, f_mid, f1)
             if self._stagnates(snes, x, y, step, f0):
                 self.kink_steps += 1
-                self._squared_norm_at(x, y, 1.0, point, residual)
                 self.offer(point, residual)
                 return halvings > 0
             self.cut_steps += 1

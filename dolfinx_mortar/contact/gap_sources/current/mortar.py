@@ -82,6 +82,9 @@ class CurrentMortarGap(CurrentSurfaceGap):
     """
 
     moving_pattern = True
+    #: the segmentation and the Jets keep overlaps of any width, and must agree on it
+    #: (a sliver's derivative is not round-off: docs/DESIGN.md, §Tolerances)
+    KEEP_SLIVERS = True
 
     def __init__(self, slave: LagrangeSurface, master: LagrangeSurface, kind: BasisKind,
                  law: PenaltyLaw, search_radius: Optional[float] = None,
@@ -136,7 +139,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
         return dealt.gap_jets(self.segment_points, self.segment_weights, zero_length,
                               with_hessian=with_hessian, with_positive_part=with_positive_part,
                               axisymmetric=self.slave.axisymmetric, node_weights=node_weights,
-                              with_mass=with_mass, keep_slivers=True)
+                              with_mass=with_mass, keep_slivers=self.KEEP_SLIVERS)
 
     # -- CurrentSurfaceGap hooks ------------------------------------------------------------
     def _gap(self, u_nodes: FloatArray, W: FloatArray,
@@ -153,7 +156,7 @@ class CurrentMortarGap(CurrentSurfaceGap):
                                                        if self.search_radius is None
                                                        else None),
                                   keep_points=self.pointwise, self_contact=self.self_contact,
-                                  deal_segmentation=True, keep_slivers=True)
+                                  deal_segmentation=True, keep_slivers=self.KEEP_SLIVERS)
         if self.boundary_modification:
             return covered_gap(self, coupling, W, surface.W)
         all_cells = slave.cells[coupling.pairs[:, 0]]
