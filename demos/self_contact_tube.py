@@ -76,6 +76,9 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     parser.add_argument("--squeeze", type=float, default=0.95, help="the plate's travel (0.95)")
     parser.add_argument("--steps", type=int, default=19, help="load steps (19)")
     parser.add_argument("--kind", default="LmLS*", help="mortar basis kind (LmLS*)")
+    parser.add_argument("--configuration", default="previous",
+                        choices=("initial", "previous", "current"),
+                        help="where the bases live (previous)")
     parser.add_argument("--length", type=float, default=0.0,
                         help="0: plane strain; else a tube this long in 3D, held in z at z = 0 "
                              "(a symmetry plane) and free at its other end")
@@ -99,7 +102,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
         end = fem.locate_dofs_topological(V.sub(2), 2, tags.find(END))
         bcs.append(fem.dirichletbc(0.0, end, V.sub(2)))
     penalty = 100 * E / args.h
-    options = dict(kind=args.kind, penalty=penalty, basis_configuration="previous")
+    options = dict(kind=args.kind, penalty=penalty, basis_configuration=args.configuration)
     def plane(y: float, ny: float) -> RigidPlane:
         return RigidPlane([0.0, y, 0.0][:dim], [0.0, ny, 0.0][:dim])
 
@@ -125,7 +128,7 @@ def main(argv: Optional[Sequence[str]] = None) -> dict:
     result = LoadPathSolver(problem).solve(lambda t: top.move_to([0.0, -args.squeeze * t, 0.0][:dim]),
                                            load_steps=args.steps, on_step=record)
     figures = {"steps": steps, "newton_iterations": result.newton_iterations,
-               "h": args.h, "kind": args.kind, "length": args.length,
+               "h": args.h, "kind": args.kind, "configuration": args.configuration, "length": args.length,
                # wall times (s) over the whole path: the self-contact term's work by part,
                # and the bulk's assembly, to compare per Newton iteration
                "self_contact_timings": dict(terms[2].timings),

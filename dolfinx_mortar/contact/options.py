@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Optional
 
 import numpy as np
@@ -51,6 +51,17 @@ class ContactOptions:
     def penalty(self) -> float:
         """ε, pressure per length."""
         return self.law.penalty
+
+    def frozen_phase(self) -> "ContactOptions":
+        """The options of the "previous" model that solves each load step of the
+        current configuration first. In self-contact the dual kinds' boundary
+        modification is refused on the current surface only (:meth:`checked`);
+        the frozen phase takes it, as ``"previous"`` does: unmodified, the
+        collapsing tube's frozen phase read a false penetration and diverged
+        before the current surface's own check could name it."""
+        modified = self.boundary_modification or (
+            self.self_contact and self.kind in DUAL_KINDS and not self.law.pointwise)
+        return replace(self, boundary_modification=modified)
 
     @classmethod
     def checked(cls, kind: KindLike, penalty: float, scaling: str, active_set: str,

@@ -215,6 +215,12 @@ class ContactTerm:
         finally:
             self._take(current)
 
+    def check_current_surface(self) -> None:
+        """Called by a load-path driver when a step's frozen phase has converged
+        (``basis_configuration="current"``), before the current surface takes
+        over: NotImplementedError where a dual kind reads a false penetration there."""
+        self._configuration.check_current_surface(self.options, self.source, self.u)
+
     def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:
         """After a converged step, before :meth:`accept_step`: True where the
         contact zone reached the default search radius and the bases were

@@ -19,12 +19,14 @@ from dolfinx_mortar.contact.gap_sources.current import CurrentObstacleGap
 from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
 from dolfinx_mortar.contact.gap_sources.self_contact import CurrentSelfContactGap, SelfContactGap
 from dolfinx_mortar.contact.gap_sources.global_gap import GlobalGap, covered_mass
+from dolfinx_mortar.contact.laws import safe_weights
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.options import ContactOptions
 from dolfinx_mortar.contact.gap_sources.source import GapSource
 from dolfinx_mortar.kinds import DUAL_KINDS, is_global, kind_name
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
+from dolfinx_mortar.tolerance import NEAR_CONTACT
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -41,7 +43,8 @@ def current_model(options: ContactOptions, slave: LagrangeSurface,
     else:
         model = CurrentMortarGap(slave, master, options.kind, options.law, options.search_radius,
                                  options.boundary_modification)
-    model.frozen_at = partial(frozen_model, options, slave, master, obstacle)
+    model.frozen_at = partial(frozen_model, options.frozen_phase(), slave, master,
+                              obstacle)
     return model
 
 
@@ -92,7 +95,8 @@ def moved(u_nodes: FloatArray, since: Optional[FloatArray], comm: MPI.Comm) -> b
 
 def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
                              master: Optional[LagrangeSurface], current: GapSource, u,
-                             u_nodes: FloatArray) -> Optional[MortarCoupling]:
+                             u_nodes: FloatArray,
+                             in_contact: bool = False) -> Optional[MortarCoupling]:
     """Refuse a dual kind on the current surface against an elastic master
     where it reads a penetration that is not there (NotImplementedError).
 
@@ -107,8 +111,15 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     compared here, where the term is made, with the modified ones of the
     frozen model: a node that only the current surface sees penetrating stops
     the construction, with the way out. A master that covers the slave's
-    elements in full (a cylinder on a wider block) passes. Returns the frozen model's coupling where it was made
-    (None elsewhere), for the term's other checks.
+    elements in full (a cylinder on a wider block) passes. Returns the frozen
+    model's coupling where it was made (None elsewhere), for the term's other
+    checks.
+
+    ``in_contact``: u is where a load step's frozen phase converged, with the
+    surfaces pressed. The two models' normals differ at the contact edge, so
+    only a node whose mean gap ``ĝ_A/W_A`` reads a penetration deeper than
+    :data:`~dolfinx_mortar.tolerance.NEAR_CONTACT` of its element length, where
+    the frozen model reads none, is false (where the term is made, any depth).
     """
     if not (master is not None and options.kind in DUAL_KINDS and not options.law.pointwise
             and not options.boundary_modification):
@@ -116,11 +127,16 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     frozen = replace(options, basis_configuration="previous", boundary_modification=True)
     modified = frozen_model(frozen, slave, master, None, u_nodes, u.x.petsc_vec.copy())
     owned = slave.layout.num_owned
-    gaps = current.evaluate(u, None).gaps[:owned]
+    state = current.evaluate(u, None)
+    gaps = state.gaps[:owned]
     reference = modified.evaluate(u, None).gaps[:owned]
     comm = slave.layout.comm
     tolerance = slave.zero_length
-    false = (gaps > tolerance) & (reference <= tolerance)
+    least = tolerance
+    if in_contact:
+        gaps = gaps / safe_weights(state.lumped_weights[:owned])
+        least = np.maximum(tolerance, NEAR_CONTACT * current.basis.node_lengths[:owned])
+    false = (gaps > least) & (reference <= tolerance)
     worst = comm.allreduce((float(gaps[false].max()) if false.any() else 0.0, comm.rank),
                            op=MPI.MAXLOC)
     count = comm.allreduce(int(false.sum()))
@@ -131,9 +147,11 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
         node = int(np.flatnonzero(false)[np.argmax(gaps[false])])
         where = np.array2string(slave.x[node] + u_nodes[node], precision=4)
     where = comm.bcast(where, root=worst[1])
+    other = "itself (self-contact)" if options.self_contact else "an elastic master"
+    when = ", where the load step's frozen phase converged" if in_contact else ""
     raise NotImplementedError(
-        f"{kind_name(options.kind)} on the current surface against an elastic master reads "
-        f"a false penetration at {count} slave node(s) (largest {worst[0]:.3g} at {where}): "
+        f"{kind_name(options.kind)} on the current surface against {other} reads a false "
+        f"penetration at {count} slave node(s) (largest {worst[0]:.3g} at {where}{when}): "
         "the master covers their elements only in part (cut by the search radius or the "
         "master's edge), where the dual functions are negative. The boundary modification "
         "cures this (boundary_modification=True, the default between two bodies; refused in "

@@ -101,6 +101,9 @@ class StepNewton:
                     # Newton ran and got nowhere (not a failed linear solve or residual)
                     cause += self._contact_hint()
                 return NewtonOutcome(reason, phases, iterations, cause, reference, linear)
+            if frozen:
+                for term in self.problem.contacts:
+                    term.check_current_surface()
         return NewtonOutcome(reason, phases, iterations, "", reference, linear)
 
     def _start(self, x: PETSc.Vec, increment: Optional[PETSc.Vec]) -> float:
