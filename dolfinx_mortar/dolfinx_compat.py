@@ -19,7 +19,11 @@ geometry dofmap, coordinate element     ``dofmap``, ``cmap``   ``dofmaps[0]``, `
 from __future__ import annotations
 
 import contextlib
+import importlib.util
+import logging
 import os
+import warnings
+from pathlib import Path
 from typing import Callable, Optional
 
 import dolfinx
@@ -32,6 +36,31 @@ import numpy.typing as npt
 from dolfinx import cpp as _cpp
 from mpi4py import MPI
 from petsc4py import PETSc
+
+
+
+def _show_warnings_ffcx_hid() -> None:
+    """Show Python warnings again where FFCx's package init hid them.
+
+    FFCx 0.9 (Debian 13) calls ``logging.captureWarnings(True)`` when it is
+    imported, and DOLFINx imports it. Python's warnings then go to the
+    "py.warnings" logger, which gets a NullHandler where nothing handles it:
+    in a script that does not configure logging every warning vanished, the
+    library's too ("the contact misses them", "the penalty is too low"), while
+    pytest, which catches warnings itself, saw them all (FEniCS/ffcx#712; FFCx
+    0.11 does it in its command line only). Undone where FFCx's own init does
+    it, decided on its source rather than its version.
+    """
+    captured = getattr(warnings.showwarning, "__module__", None) == "logging"
+    spec = importlib.util.find_spec("ffcx")
+    if not captured or spec is None or spec.origin is None:
+        return
+    with contextlib.suppress(OSError):
+        if "captureWarnings(capture=True)" in Path(spec.origin).read_text():
+            logging.captureWarnings(False)
+
+
+_show_warnings_ffcx_hid()
 
 __all__ = ["model_to_mesh", "create_mesh", "create_cell_partitioner", "geometry_dofmap",
            "coordinate_element", "adjacency_list", "cpp_adjacency_list", "ghosted_vector",

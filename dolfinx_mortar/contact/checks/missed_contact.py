@@ -68,6 +68,9 @@ class MissedContact:
         self.given_radius = term.options.search_radius
         self.widenings = 0
         self._warned = False
+        #: the radius of the first search (about an element where none was given), below
+        #: whose half a node's motion cannot have taken it past the pairs
+        self._first_radius: Optional[float] = None
         #: on the current surface: the displacement of the last accepted step
         #: (None: the start), from which a step's motion is measured
         self._accepted: Optional[PETSc.Vec] = None
@@ -117,6 +120,24 @@ class MissedContact:
         count = term.comm.allreduce(int(np.sum(missed[:n])))
         return count, term.results.deepest(np.where(missed, depth, -np.inf))
 
+    def _missed_for_good(self, count: int, ratio: float, depth: float, where: list,
+                         futile: bool) -> str:
+        """The warning where wider searches do not pair what was missed."""
+        what = (f"{count} slave node(s) passed through the master outside the pairs "
+                f"(deepest {depth:.3g}, {ratio:.3g} element lengths, at {where})")
+        if not futile:
+            return (f"{what} after {self.widenings} wider searches: the contact misses "
+                    "them. Pass a larger search_radius or smaller load steps")
+        configuration = self.term.options.basis_configuration
+        advice = ("smaller load steps" if configuration == "current" else
+                  "basis_configuration='current', or smaller load steps" if
+                  configuration == "previous" else
+                  "basis_configuration='previous' or 'current'")
+        return (f"{what}, although the search radius covers their motion since the pairs "
+                f"were searched: the pairs, projected along the normals of the "
+                f"configuration the bases were built in ('{configuration}'), do not follow "
+                f"a motion this large, and the contact misses them. Use {advice}")
+
     def searched_radius(self) -> float:
         """How far every slave facet surely looked for the master (collective):
         the frozen bases' search radius; on the current surface the radius given,
@@ -141,21 +162,25 @@ class MissedContact:
         if term.master is None or self._warned:
             return None
         radius = self.searched_radius()
+        if self._first_radius is None:
+            self._first_radius = radius
         motion = self.motion()
-        if 2.0 * motion <= radius:
+        if 2.0 * motion <= min(radius, self._first_radius):
             # no slave node can have reached a master facet that lay beyond the
-            # radius when the pairs were searched: nothing to search again
+            # radius when the pairs were searched, nor moved far from where the
+            # pairs project it: nothing to search again. A widened radius alone
+            # is not enough: it holds the facets the motion reaches, not the
+            # pairs the projection makes there (the tube's hole in "initial":
+            # radius 1.96 against a motion of 0.96, no pair across the hole)
             return None
         reach = radius + 2.0 * motion
         count, (ratio, depth, where) = self.missed(state, reach)
         if count == 0:
             return None
-        if self.widenings >= MAX_MISSED_WIDENINGS:
+        futile = radius >= 2.0 * motion
+        if futile or self.widenings >= MAX_MISSED_WIDENINGS:
             self._warned = True
-            warnings.warn(f"{count} slave node(s) passed through the master outside the "
-                          f"pairs (deepest {depth:.3g}, {ratio:.3g} element lengths, at "
-                          f"{where}) after {self.widenings} wider searches: the contact "
-                          "misses them. Pass a larger search_radius or smaller load steps",
+            warnings.warn(self._missed_for_good(count, ratio, depth, where, futile),
                           RuntimeWarning, stacklevel=4)
             return None
         self.widenings += 1
