@@ -14,6 +14,7 @@ gmsh models                             ``io.gmshio``, tuple   ``io.gmsh``, ``Me
 cell partitioner from a graph one       ``(part, mode)``       ``(part, mode, max_links)``
 geometry dofmap, coordinate element     ``dofmap``, ``cmap``   ``dofmaps[0]``, ``cmaps[0]``
 ``meshtags_from_entities`` entities     C++ adjacency list     ``graph.AdjacencyList``
+Python warnings after FFCx's import     captured (hidden)      shown (FFCx 0.11)
 ======================================  =====================  ==========================
 """
 from __future__ import annotations
