@@ -197,7 +197,7 @@ def test_the_tube_on_the_current_surface_matches_previous():
 def test_a_dual_kind_on_the_tube_s_current_surface_is_refused_where_its_faces_meet(kind):
     """Where the hole's faces meet, its own surface covers facets in part, and the
     dual kinds on the current surface (whose boundary modification is refused in
-    self-contact) read a false penetration of 0.1-0.3 element lengths. Newton
+    self-contact) read a false penetration of 2.6 element lengths. Newton
     diverged to NaN and the user was told "Newton failed"; the step's frozen phase,
     unmodified, failed first. Now the frozen phase takes the modification, as
     "previous" does, and the current surface is refused with the reason where the

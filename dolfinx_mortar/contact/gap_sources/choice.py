@@ -133,9 +133,10 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     comm = slave.layout.comm
     tolerance = slave.zero_length
     least = tolerance
+    lengths = current.basis.node_lengths[:owned]
     if in_contact:
         gaps = gaps / safe_weights(state.lumped_weights[:owned])
-        least = np.maximum(tolerance, NEAR_CONTACT * current.basis.node_lengths[:owned])
+        least = np.maximum(tolerance, NEAR_CONTACT * lengths)
     false = (gaps > least) & (reference <= tolerance)
     worst = comm.allreduce((float(gaps[false].max()) if false.any() else 0.0, comm.rank),
                            op=MPI.MAXLOC)
@@ -145,13 +146,15 @@ def refuse_false_penetration(options: ContactOptions, slave: LagrangeSurface,
     where = ""
     if comm.rank == worst[1]:
         node = int(np.flatnonzero(false)[np.argmax(gaps[false])])
-        where = np.array2string(slave.x[node] + u_nodes[node], precision=4)
+        where = "at " + np.array2string(slave.x[node] + u_nodes[node], precision=4)
+        if in_contact:       # a mean gap: in element lengths too
+            where = f"{gaps[node] / lengths[node]:.3g} element lengths, {where}"
     where = comm.bcast(where, root=worst[1])
     other = "itself (self-contact)" if options.self_contact else "an elastic master"
     when = ", where the load step's frozen phase converged" if in_contact else ""
     raise NotImplementedError(
         f"{kind_name(options.kind)} on the current surface against {other} reads a false "
-        f"penetration at {count} slave node(s) (largest {worst[0]:.3g} at {where}{when}): "
+        f"penetration at {count} slave node(s) (largest {worst[0]:.3g}, {where}{when}): "
         "the master covers their elements only in part (cut by the search radius or the "
         "master's edge), where the dual functions are negative. The boundary modification "
         "cures this (boundary_modification=True, the default between two bodies; refused in "
