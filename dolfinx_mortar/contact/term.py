@@ -67,10 +67,9 @@ class ContactTerm:
         Mortar basis kind, any of the six (docs/DESIGN.md, §Bases).
     penalty
         ε, pressure per length (consistent scaling).
-    scaling
-        ``"consistent"`` (default) or ``"seed"`` (docs/DESIGN.md, §Scalings).
-    active_set
-        ``"nodal"`` (default, ε on ⟨d̄_A⟩) or ``"pointwise"`` (``p_A = ε∫M̄_A⟨d⟩``).
+    scaling, active_set
+        ``"consistent"`` (default) or ``"seed"`` (docs/DESIGN.md, §Scalings); ``"nodal"``
+        (default, ε on ⟨d̄_A⟩) or ``"pointwise"`` (``p_A = ε∫M̄_A⟨d⟩``).
     basis_configuration
         ``"initial"`` (default): bases and segmentation in the reference
         configuration, good up to about one element of slip; ``"previous"``:
@@ -80,20 +79,17 @@ class ContactTerm:
         Transformed basis on quadratic triangle facets (always on axisymmetric P2 lines).
     boundary_modification
         Elastic master, dual kinds: the basis rebuilt over the covered part of
-        partly covered slave facets (Popp et al. 2013; docs/DESIGN.md, §Boundary
-        modification). ``None`` (default): on where it is implemented (dual
-        kinds, elastic master, nodal set, "initial" and "previous").
+        partly covered slave facets (docs/DESIGN.md, §Boundary modification).
+        ``None`` (default): on wherever it is implemented.
     search_radius
-        How far along its normal a slave facet reaches for master facets
-        (default the largest slave facet diameter; widened where contact needs it).
+        How far a slave facet reaches for master facets (default: the largest
+        slave facet; widened where contact needs it).
     axisymmetric
-        The mesh is the (r, z) half-plane of a body of revolution: every contact
-        integral carries 2πr, forces are the whole body's (docs/AXISYMMETRIC.md;
-        the bulk form must be axisymmetric too).
+        The mesh is the (r, z) half-plane of a body of revolution: contact
+        integrals carry 2πr (docs/AXISYMMETRIC.md; the bulk form too).
     friction
-        A friction law (:class:`~dolfinx_mortar.contact.laws.CoulombFriction`, or
-        any :class:`~dolfinx_mortar.contact.laws.TangentialLaw`); None:
-        frictionless (default). Its history moves on in :meth:`accept_step`.
+        A friction law (:class:`~dolfinx_mortar.contact.laws.CoulombFriction`, or any
+        :class:`~dolfinx_mortar.contact.laws.TangentialLaw`); None: frictionless.
     self_contact
         The slave surface is its own master: a body that may touch itself, or
         several bodies under one term (docs/SELF_CONTACT.md).
@@ -216,9 +212,7 @@ class ContactTerm:
             self._take(current)
 
     def check_current_surface(self) -> None:
-        """Called by a load-path driver when a step's frozen phase has converged
-        (``basis_configuration="current"``), before the current surface takes
-        over: NotImplementedError where a dual kind reads a false penetration there."""
+        """A step's frozen phase converged ("current"): refuse a false penetration."""
         self._configuration.check_current_surface(self.options, self.source, self.u)
 
     def widen_search_radius(self, state: Optional[ContactState] = None) -> bool:

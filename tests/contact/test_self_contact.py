@@ -13,7 +13,7 @@ from mpi4py import MPI
 
 from demo_support import mirror as two_bodies
 from demo_support.self_mirror import CONTACT, build, self_mirror
-from dolfinx_mortar import ContactProblem, ContactTerm, CoulombFriction, RigidPlane
+from dolfinx_mortar import ContactProblem, ContactTerm, RigidPlane
 from dolfinx_mortar.meshes.merge_meshes import merge_meshes
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.facet_surface import facet_surface
