@@ -60,7 +60,7 @@ class ContactOptions:
         collapsing tube's frozen phase read a false penetration and diverged
         before the current surface's own check could name it."""
         modified = self.boundary_modification or (
-            self.self_contact and self.kind in DUAL_KINDS and not self.law.pointwise)
+            self.self_contact and modification_applies(self.kind, self.law))
         return replace(self, boundary_modification=modified)
 
     @classmethod
@@ -81,8 +81,7 @@ class ContactOptions:
             # master covers only there reads a separation as a penetration. The
             # modification is the cure wherever it is implemented.
             # Not for self-contact on the current surface (refused below).
-            boundary_modification = (elastic_master and kind in DUAL_KINDS
-                                     and not law.pointwise
+            boundary_modification = (elastic_master and modification_applies(kind, law)
                                      and not (self_contact and basis_configuration == "current"))
         if basis_configuration == "current" and boundary_modification and law.pointwise:
             raise NotImplementedError("basis_configuration='current' with the boundary "
@@ -110,6 +109,12 @@ class ContactOptions:
         return cls(kind, law, basis_configuration, bool(boundary_modification),
                    None if search_radius is None else float(search_radius), bool(axisymmetric),
                    bool(self_contact))
+
+
+def modification_applies(kind: BasisKind, law: PenaltyLaw) -> bool:
+    """Whether the boundary modification is defined for ``kind`` under ``law``
+    (the dual kinds with the nodal active set), the one rule of its defaults."""
+    return kind in DUAL_KINDS and not law.pointwise
 
 
 def check_self_contact(kind: BasisKind, basis_configuration: str, pointwise: bool) -> None:
