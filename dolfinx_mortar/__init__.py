@@ -43,6 +43,7 @@ from dolfinx_mortar import kernels as _kernels_check  # noqa: F401
 from dolfinx_mortar import kinds
 from dolfinx_mortar.bases import basis
 from dolfinx_mortar.bases.basis import MortarBasis
+from dolfinx_mortar.collective_warnings import ContactWarning
 from dolfinx_mortar.errors import DegenerateGeometryError
 from dolfinx_mortar.kinds import KIND_NAMES, parse_kind
 from dolfinx_mortar.surfaces import lagrange, nurbs
@@ -65,7 +66,7 @@ _LAZY = {
 }
 
 __all__ = ["basis", "kinds", "lagrange", "nurbs", "MortarBasis", "KIND_NAMES",
-           "parse_kind", "DegenerateGeometryError", *_LAZY]
+           "parse_kind", "DegenerateGeometryError", "ContactWarning", *_LAZY]
 __version__ = _package_version()
 
 

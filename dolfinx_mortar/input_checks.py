@@ -17,6 +17,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar import dolfinx_compat
+from dolfinx_mortar.collective_warnings import deciding
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
 
@@ -30,11 +31,13 @@ def collective_checks(comm: MPI.Comm) -> Iterator[None]:
     message. A check that failed on one rank only (a NaN penalty on rank 1)
     used to raise there while the other ranks went on into the next
     collective and waited for ever. Collective: every rank must enter the
-    block.
+    block. A library warning issued in the block belongs to ``comm``
+    (:func:`~dolfinx_mortar.collective_warnings.warn`).
     """
     failure: Optional[BaseException] = None
     try:
-        yield
+        with deciding(comm):
+            yield
     except Exception as error:      # noqa: BLE001 - re-raised below, on every rank
         failure = error
     first = comm.allreduce(comm.rank if failure is not None else comm.size, op=MPI.MIN)

@@ -51,3 +51,50 @@ def test_warnings_are_shown_after_dolfinx_is_imported():
                                            if not k.startswith(("OMPI_", "PMIX_"))})
     assert run.returncode == 0, run.stderr
     assert "RuntimeWarning: the contact misses them" in run.stderr
+
+
+SHOWN_ONCE = """
+import warnings
+import numpy as np
+from mpi4py import MPI
+from dolfinx import fem, mesh
+from dolfinx_mortar import ContactTerm, ContactWarning, RigidPlane
+
+domain = mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
+facets = mesh.locate_entities_boundary(domain, 1, lambda x: np.isclose(x[1], 0.0))
+tags = mesh.meshtags(domain, 1, facets, np.full(len(facets), 1, dtype=np.int32))
+u = fem.Function(V)
+
+
+def term():
+    return ContactTerm(u, tags, 1, obstacle=RigidPlane([0.0, -0.1], [0.0, 1.0]),
+                       kind="LcLS*", penalty=1e3, active_set="pointwise")
+
+
+term()                                  # the default filters
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")     # what a test or a user asking for them sees
+    term()
+print(MPI.COMM_WORLD.rank, *[w.category.__name__ for w in caught
+                             if issubclass(w.category, ContactWarning)], flush=True)
+"""
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="one child run of 2 ranks is enough")
+def test_a_warning_of_all_ranks_is_shown_once_and_issued_on_each():
+    """Under mpirun every rank printed each of the library's warnings (16 copies
+    on 16 ranks). The first rank of the communicator shows it; the others issue
+    a copy that the default filters ignore, and that a filter asking for
+    warnings ("always", "error", pytest.warns) sees on every rank, so that an
+    error raises on all of them together."""
+    env = {k: v for k, v in __import__("os").environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "PMI_"))}
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_btl="self,sm", OMP_NUM_THREADS="1")
+    run = subprocess.run(["mpirun", "-n", "2", "--oversubscribe", sys.executable, "-P", "-c",
+                          SHOWN_ONCE], capture_output=True, text=True, timeout=300, env=env)
+    assert run.returncode == 0, run.stderr
+    assert run.stderr.count("the pointwise active set with a dual kind") == 1, run.stderr
+    ranks = sorted(line for line in run.stdout.splitlines() if line[:1].isdigit())
+    assert ranks == ["0 ContactWarning", "1 ContactWarningCopy"], run.stdout

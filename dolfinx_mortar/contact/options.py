@@ -1,12 +1,12 @@
 """The options of a contact term, checked once where the term is made."""
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, replace
 from typing import Optional
 
 import numpy as np
 
+from dolfinx_mortar.collective_warnings import warn
 from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, is_global, parse_kind
 
@@ -102,10 +102,10 @@ class ContactOptions:
             raise ValueError(f"the search radius must be positive and finite, got "
                              f"{search_radius!r}")
         if law.pointwise and kind in DUAL_KINDS:
-            warnings.warn("the pointwise active set with a dual kind: ∫M̄_A⟨d⟩ is negative "
-                          "next to the contact edge, and Newton did not converge on any "
-                          "curved contact tested (Hertz 2D); prefer active_set='nodal'",
-                          RuntimeWarning, stacklevel=4)
+            warn("the pointwise active set with a dual kind: ∫M̄_A⟨d⟩ is negative "
+                 "next to the contact edge, and Newton did not converge on any "
+                 "curved contact tested (Hertz 2D); prefer active_set='nodal'",
+                 stacklevel=4)
         return cls(kind, law, basis_configuration, bool(boundary_modification),
                    None if search_radius is None else float(search_radius), bool(axisymmetric),
                    bool(self_contact))

@@ -10,7 +10,6 @@ prescribed displacements scaled by one load factor, a
 """
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 from typing import Callable, Optional, Sequence, Union
 
@@ -19,6 +18,7 @@ import ufl
 from dolfinx import fem
 from petsc4py import PETSc
 
+from dolfinx_mortar.collective_warnings import warn
 from dolfinx_mortar.contact.laws import CoulombFriction
 from dolfinx_mortar.contact.obstacles import RigidObstacle
 from dolfinx_mortar.contact.term import ContactTerm
@@ -94,10 +94,10 @@ class ContactProblem:
             if not (np.isfinite(E) and E > 0 and -1 < nu < 0.5):
                 raise ValueError(f"need a finite E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
             if nu > NEARLY_INCOMPRESSIBLE and V.ufl_element().degree == 1:
-                warnings.warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
-                              "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the "
-                              "contact force of nu = 0.3); use quadratic elements or a "
-                              "mixed form", RuntimeWarning, stacklevel=2)
+                warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
+                     "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the "
+                     "contact force of nu = 0.3); use quadratic elements or a "
+                     "mixed form", stacklevel=2)
             fixed, tractions = fixed or {}, tractions or {}
             check_boundary_data(fixed, tractions, gdim)
         check_tags(mesh, facet_tags, [*fixed, *tractions])

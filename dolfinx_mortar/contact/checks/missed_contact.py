@@ -26,7 +26,6 @@ radius that covers the motion.
 from __future__ import annotations
 
 import logging
-import warnings
 from typing import Optional
 
 import numpy as np
@@ -34,6 +33,7 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.collective_warnings import warn
 from dolfinx_mortar.contact.gap_sources import FACET_SEARCH_FACTOR
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.mortar.coupling import MortarCoupling
@@ -180,17 +180,17 @@ class MissedContact:
         futile = radius >= 2.0 * motion
         if futile or self.widenings >= MAX_MISSED_WIDENINGS:
             self._warned = True
-            warnings.warn(self._missed_for_good(count, ratio, depth, where, futile),
-                          RuntimeWarning, stacklevel=4)
+            warn(self._missed_for_good(count, ratio, depth, where, futile),
+                 term.comm, stacklevel=4)
             return None
         self.widenings += 1
         wider = max(4.0 * radius, reach)
         if self.widenings == 1 and self.given_radius is not None:
-            warnings.warn(f"the search radius {self.given_radius:.3g} that was given missed "
-                          f"contact: {count} slave node(s) passed through the master outside "
-                          f"the pairs (deepest {depth:.3g} at {where}); the bases are rebuilt "
-                          f"with {wider:.3g} and the step solved again",
-                          RuntimeWarning, stacklevel=4)
+            warn(f"the search radius {self.given_radius:.3g} that was given missed "
+                 f"contact: {count} slave node(s) passed through the master outside "
+                 f"the pairs (deepest {depth:.3g} at {where}); the bases are rebuilt "
+                 f"with {wider:.3g} and the step solved again",
+                 term.comm, stacklevel=4)
         if term.comm.rank == 0:
             logger.info("%d slave node(s) passed through the master outside the pairs "
                         "(deepest %.3g, %.3g element lengths, at %s): bases rebuilt with the "

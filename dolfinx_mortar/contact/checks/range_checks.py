@@ -9,13 +9,13 @@ converged step and at the end of a solve.
 from __future__ import annotations
 
 import logging
-import warnings
 from typing import Optional
 
 import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
+from dolfinx_mortar.collective_warnings import warn
 from dolfinx_mortar.contact.checks.missed_contact import MissedContact
 from dolfinx_mortar.contact.checks.setup_checks import (check_initial_overlap,
                                                         refuse_a_self_overlap,
@@ -133,10 +133,10 @@ class RangeChecks:
                         "partly covered by the master (at the edge of the search radius or "
                         "of the master) shows a false penetration: pass "
                         "boundary_modification=True")
-            warnings.warn(f"the initial configuration penetrates by {gap:.3g} ({ratio:.3g} "
-                          f"slave element lengths) at the slave node {x}: check the "
-                          "obstacle's position and normal, or the tags of slave and master"
-                          + hint, RuntimeWarning, stacklevel=3)
+            warn(f"the initial configuration penetrates by {gap:.3g} ({ratio:.3g} "
+                 f"slave element lengths) at the slave node {x}: check the "
+                 "obstacle's position and normal, or the tags of slave and master"
+                 + hint, self.term.comm, stacklevel=3)
 
     def warn_if_the_penalty_is_low(self, deepest: tuple[float, float, list]) -> None:
         """Warn when the deepest :meth:`penetration` of a solve exceeds
@@ -156,11 +156,11 @@ class RangeChecks:
             return
         penalty = self.term.options.penalty
         suggested = penalty * ratio / SUGGESTED_PENETRATION
-        warnings.warn(f"at convergence the slave surface penetrates by {depth:.3g} "
-                      f"({ratio:.2g} slave element lengths) at the node {x}: the penalty "
-                      f"{penalty:.3g} is low for this mesh; about {suggested:.3g} would "
-                      f"bring the penetration to {SUGGESTED_PENETRATION:g} element lengths "
-                      "(it falls about as 1/penalty)", RuntimeWarning, stacklevel=3)
+        warn(f"at convergence the slave surface penetrates by {depth:.3g} "
+             f"({ratio:.2g} slave element lengths) at the node {x}: the penalty "
+             f"{penalty:.3g} is low for this mesh; about {suggested:.3g} would "
+             f"bring the penetration to {SUGGESTED_PENETRATION:g} element lengths "
+             "(it falls about as 1/penalty)", self.term.comm, stacklevel=3)
 
     def warn_if_the_body_passed_through(self) -> None:
         """Log a warning (once, collective) when at the present u a node off the
@@ -205,11 +205,11 @@ class RangeChecks:
         s = self.term.results.slip(state)
         if s > SLIP_LIMIT:
             self._slip_warned = True
-            warnings.warn(f"contact surfaces slipped {s:.3g} element lengths past the "
-                          "configuration of the bases (basis_configuration='initial', valid "
-                          "to about one element of slip): the forces are no longer reliable; "
-                          "use basis_configuration='previous' or 'current'",
-                          RuntimeWarning, stacklevel=3)
+            warn(f"contact surfaces slipped {s:.3g} element lengths past the "
+                 "configuration of the bases (basis_configuration='initial', valid "
+                 "to about one element of slip): the forces are no longer reliable; "
+                 "use basis_configuration='previous' or 'current'",
+                 self.term.comm, stacklevel=3)
 
     def warn_if_no_master_is_in_reach(self, coupling: Optional[MortarCoupling] = None) -> None:
         """Against an elastic master, warn when no slave facet finds a master
@@ -235,21 +235,19 @@ class RangeChecks:
         either_way = MortarCoupling(self.term.slave, self.term.master, search_radius=radius,
                                     opposing_normals_only=False)
         if comm.allreduce(len(either_way.pairs)) > 0:
-            warnings.warn(f"the master surface faces away from the slave: within the search "
-                          f"radius {radius:.3g} the slave facets find only master facets "
-                          "whose outward normals point the same way as theirs, and those "
-                          "are never paired. The master must be the surface of the other "
-                          "body that faces the slave: check the master_tag, and that "
-                          "slave and master tags are not swapped", RuntimeWarning,
-                          stacklevel=3)
+            warn(f"the master surface faces away from the slave: within the search "
+                 f"radius {radius:.3g} the slave facets find only master facets "
+                 "whose outward normals point the same way as theirs, and those "
+                 "are never paired. The master must be the surface of the other "
+                 "body that faces the slave: check the master_tag, and that "
+                 "slave and master tags are not swapped", comm, stacklevel=3)
             return
         never = (" With basis_configuration='initial' the pairs are found only here, so "
                  "it never will." if self.configuration.pairs_found_once else "")
-        warnings.warn(f"no slave facet finds a master facet within the search radius "
-                      f"{radius:.3g} along its normal: the contact cannot act until the "
-                      f"surfaces come within it.{never} Check the slave and master tags and "
-                      "the bodies' positions, or pass a larger search_radius", RuntimeWarning,
-                      stacklevel=3)
+        warn(f"no slave facet finds a master facet within the search radius "
+             f"{radius:.3g} along its normal: the contact cannot act until the "
+             f"surfaces come within it.{never} Check the slave and master tags and "
+             "the bodies' positions, or pass a larger search_radius", comm, stacklevel=3)
 
     def contact_reached_the_search_radius(self, state: Optional[ContactState] = None) -> bool:
         """With bases frozen against an elastic master: whether the contact zone
@@ -324,9 +322,9 @@ class RangeChecks:
                                 "solved again", radius, 4 * radius)
                 return 4 * radius
         self._radius_warned = True
-        warnings.warn(f"the contact zone reached slave nodes that found no master within "
-                      f"the search radius {radius:.3g}, though a master lies beyond it: the "
-                      f"pressure is cut off there. Pass a larger search_radius (e.g. "
-                      f"{4 * radius:.3g}) or basis_configuration='previous'",
-                      RuntimeWarning, stacklevel=3)
+        warn(f"the contact zone reached slave nodes that found no master within "
+             f"the search radius {radius:.3g}, though a master lies beyond it: the "
+             f"pressure is cut off there. Pass a larger search_radius (e.g. "
+             f"{4 * radius:.3g}) or basis_configuration='previous'",
+             term.comm, stacklevel=3)
         return None

@@ -6,11 +6,11 @@ failures blamed on the load or on a master out of reach).
 """
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 from mpi4py import MPI
 
+from dolfinx_mortar.collective_warnings import warn
 from dolfinx_mortar.contact.checks.thresholds import DEEP_PENETRATION
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
@@ -34,12 +34,12 @@ def warn_if_the_obstacle_faces_away(obstacle, slave, comm: MPI.Comm) -> None:
         # unit vectors: facing where they point against each other at all
         facing = bool(np.any(np.einsum("cng,cng->cn", normals, outward) < 0))
     if not comm.allreduce(facing, op=MPI.LOR):
-        warnings.warn(f"the obstacle {obstacle!r} faces away from the slave surface: at "
-                      "every slave node its outward normal points the same way as the "
-                      "slave's outward normal (or across it), so the obstacle's normal "
-                      "points into the slave body and nothing can touch it. The obstacle's "
-                      "normal must point out of the obstacle, towards the body (for a "
-                      "RigidPlane: flip its normal)", RuntimeWarning, stacklevel=3)
+        warn(f"the obstacle {obstacle!r} faces away from the slave surface: at "
+             "every slave node its outward normal points the same way as the "
+             "slave's outward normal (or across it), so the obstacle's normal "
+             "points into the slave body and nothing can touch it. The obstacle's "
+             "normal must point out of the obstacle, towards the body (for a "
+             "RigidPlane: flip its normal)", comm, stacklevel=3)
 
 
 #: how many times the search radius a check of an initial overlap looks
