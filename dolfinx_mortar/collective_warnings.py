@@ -11,6 +11,8 @@ first rank of that communicator shows it: on 16 ranks a user read each warning
 """
 from __future__ import annotations
 
+import os
+import sys
 import warnings
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -54,9 +56,10 @@ def deciding(comm: Communicator) -> Iterator[None]:
         _deciding.reset(token)
 
 
-def warn(message: str, comm: Optional[Communicator] = None, stacklevel: int = 1) -> None:
+def warn(message: str, comm: Optional[Communicator] = None) -> None:
     """Issue ``message`` as a :class:`ContactWarning` on the first rank of
-    ``comm`` and as a :class:`ContactWarningCopy` on its other ranks.
+    ``comm`` and as a :class:`ContactWarningCopy` on its other ranks, from the
+    user's line that called into the library.
 
     Parameters
     ----------
@@ -65,15 +68,27 @@ def warn(message: str, comm: Optional[Communicator] = None, stacklevel: int = 1)
     comm
         The communicator whose ranks decided to warn (None: the one of the
         enclosing :func:`deciding` block). Every rank of it must call.
-    stacklevel
-        As for :func:`warnings.warn`, counted from the caller of this function.
     """
     comm = comm if comm is not None else _deciding.get()
     if comm is None:
         raise TypeError("a warning of the library needs the communicator that decided it")
     _keep_copies_quiet()
     category = ContactWarning if comm.rank == 0 else ContactWarningCopy
-    warnings.warn(message, category, stacklevel=stacklevel + 1)
+    warnings.warn(message, category, stacklevel=_first_level_outside_the_library())
+
+
+#: the package's folder: a warning names the first line outside it
+_LIBRARY = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def _first_level_outside_the_library() -> int:
+    # the stacklevel, for warnings.warn in warn(), of the first caller outside
+    # the package: a fixed level named a line of the library's load path, deep
+    # or shallow as the call came (Python 3.12's skip_file_prefixes does this too)
+    frame, level = sys._getframe(1), 1          # warn() itself
+    while frame is not None and frame.f_code.co_filename.startswith(_LIBRARY):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 def _keep_copies_quiet() -> None:

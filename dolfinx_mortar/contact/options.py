@@ -104,8 +104,7 @@ class ContactOptions:
         if law.pointwise and kind in DUAL_KINDS:
             warn("the pointwise active set with a dual kind: ∫M̄_A⟨d⟩ is negative "
                  "next to the contact edge, and Newton did not converge on any "
-                 "curved contact tested (Hertz 2D); prefer active_set='nodal'",
-                 stacklevel=4)
+                 "curved contact tested (Hertz 2D); prefer active_set='nodal'")
         return cls(kind, law, basis_configuration, bool(boundary_modification),
                    None if search_radius is None else float(search_radius), bool(axisymmetric),
                    bool(self_contact))

@@ -97,7 +97,7 @@ class ContactProblem:
                 warn(f"nu = {nu} with linear (P1) elements: the displacement-only "
                      "formulation locks as nu → 0.5 (nu = 0.4999 gave 35× the "
                      "contact force of nu = 0.3); use quadratic elements or a "
-                     "mixed form", stacklevel=2)
+                     "mixed form")
             fixed, tractions = fixed or {}, tractions or {}
             check_boundary_data(fixed, tractions, gdim)
         check_tags(mesh, facet_tags, [*fixed, *tractions])

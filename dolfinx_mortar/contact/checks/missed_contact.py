@@ -181,7 +181,7 @@ class MissedContact:
         if futile or self.widenings >= MAX_MISSED_WIDENINGS:
             self._warned = True
             warn(self._missed_for_good(count, ratio, depth, where, futile),
-                 term.comm, stacklevel=4)
+                 term.comm)
             return None
         self.widenings += 1
         wider = max(4.0 * radius, reach)
@@ -190,7 +190,7 @@ class MissedContact:
                  f"contact: {count} slave node(s) passed through the master outside "
                  f"the pairs (deepest {depth:.3g} at {where}); the bases are rebuilt "
                  f"with {wider:.3g} and the step solved again",
-                 term.comm, stacklevel=4)
+                 term.comm)
         if term.comm.rank == 0:
             logger.info("%d slave node(s) passed through the master outside the pairs "
                         "(deepest %.3g, %.3g element lengths, at %s): bases rebuilt with the "

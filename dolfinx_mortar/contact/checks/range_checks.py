@@ -136,7 +136,7 @@ class RangeChecks:
             warn(f"the initial configuration penetrates by {gap:.3g} ({ratio:.3g} "
                  f"slave element lengths) at the slave node {x}: check the "
                  "obstacle's position and normal, or the tags of slave and master"
-                 + hint, self.term.comm, stacklevel=3)
+                 + hint, self.term.comm)
 
     def warn_if_the_penalty_is_low(self, deepest: tuple[float, float, list]) -> None:
         """Warn when the deepest :meth:`penetration` of a solve exceeds
@@ -160,7 +160,7 @@ class RangeChecks:
              f"({ratio:.2g} slave element lengths) at the node {x}: the penalty "
              f"{penalty:.3g} is low for this mesh; about {suggested:.3g} would "
              f"bring the penetration to {SUGGESTED_PENETRATION:g} element lengths "
-             "(it falls about as 1/penalty)", self.term.comm, stacklevel=3)
+             "(it falls about as 1/penalty)", self.term.comm)
 
     def warn_if_the_body_passed_through(self) -> None:
         """Log a warning (once, collective) when at the present u a node off the
@@ -209,7 +209,7 @@ class RangeChecks:
                  "configuration of the bases (basis_configuration='initial', valid "
                  "to about one element of slip): the forces are no longer reliable; "
                  "use basis_configuration='previous' or 'current'",
-                 self.term.comm, stacklevel=3)
+                 self.term.comm)
 
     def warn_if_no_master_is_in_reach(self, coupling: Optional[MortarCoupling] = None) -> None:
         """Against an elastic master, warn when no slave facet finds a master
@@ -240,14 +240,14 @@ class RangeChecks:
                  "whose outward normals point the same way as theirs, and those "
                  "are never paired. The master must be the surface of the other "
                  "body that faces the slave: check the master_tag, and that "
-                 "slave and master tags are not swapped", comm, stacklevel=3)
+                 "slave and master tags are not swapped", comm)
             return
         never = (" With basis_configuration='initial' the pairs are found only here, so "
                  "it never will." if self.configuration.pairs_found_once else "")
         warn(f"no slave facet finds a master facet within the search radius "
              f"{radius:.3g} along its normal: the contact cannot act until the "
              f"surfaces come within it.{never} Check the slave and master tags and "
-             "the bodies' positions, or pass a larger search_radius", comm, stacklevel=3)
+             "the bodies' positions, or pass a larger search_radius", comm)
 
     def contact_reached_the_search_radius(self, state: Optional[ContactState] = None) -> bool:
         """With bases frozen against an elastic master: whether the contact zone
@@ -326,5 +326,5 @@ class RangeChecks:
              f"the search radius {radius:.3g}, though a master lies beyond it: the "
              f"pressure is cut off there. Pass a larger search_radius (e.g. "
              f"{4 * radius:.3g}) or basis_configuration='previous'",
-             term.comm, stacklevel=3)
+             term.comm)
         return None

@@ -39,7 +39,7 @@ def warn_if_the_obstacle_faces_away(obstacle, slave, comm: MPI.Comm) -> None:
              "slave's outward normal (or across it), so the obstacle's normal "
              "points into the slave body and nothing can touch it. The obstacle's "
              "normal must point out of the obstacle, towards the body (for a "
-             "RigidPlane: flip its normal)", comm, stacklevel=3)
+             "RigidPlane: flip its normal)", comm)
 
 
 #: how many times the search radius a check of an initial overlap looks
