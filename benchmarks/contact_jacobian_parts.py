@@ -1,13 +1,14 @@
 """Where each rank's contact Jacobian time goes: the parts of ``A += K_c``.
 
-Runs :mod:`contact_ranks` (same arguments) with the assembled Newton entry's
-``assemble`` replaced by a copy that charges each part to the rank's process
-clock: the geometric stiffness's decision, the product ``K = Gᵀ diag(ωH) G``
-(``model.jacobian``), the rows it stiffens, ``A += K`` (PETSc's MatAXPY with a
-subset pattern), the wait for the slowest rank (a barrier added here, so that
-waiting is not charged to the next part) and ``A.assemble()``. Prints one
-row per rank after contact_ranks' own tables. The library is not changed; the
-GLS kinds (augmented step) and friction are not covered.
+Runs :mod:`contact_ranks` (same arguments) with the library's own
+``AssembledEntry.assemble`` given timed stand-ins for what it calls, each part
+charged to the rank's process clock: the geometric stiffness's decision, the
+product ``K = Gᵀ diag(ωH) G`` (``model.jacobian``), the rows it stiffens,
+``A += K`` (PETSc's MatAXPY with a subset pattern), the wait for the slowest
+rank (a barrier added here before ``A.assemble()``, so that waiting is not
+charged to it) and ``A.assemble()``. Prints one row per rank after
+contact_ranks' own tables. The library is not changed; the GLS kinds
+(augmented step) are not covered.
 
     export OMP_NUM_THREADS=1 OMPI_MCA_btl=self,sm OMPI_MCA_mpi_yield_when_idle=1
     mpirun --oversubscribe -n 16 python3 benchmarks/contact_jacobian_parts.py --refine 1.5
@@ -17,6 +18,7 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
+from typing import Callable, Optional
 
 from mpi4py import MPI
 
@@ -29,40 +31,49 @@ PARTS = ("geometric", "product", "stiffened_rows", "add_stiffness", "wait", "ass
 spent = dict.fromkeys(PARTS, 0.0)
 
 
-class Clock:
-    """Charges the process time since the last call to a part."""
+def timed(call: Callable, part: str, before: Optional[Callable] = None) -> Callable:
+    """``call``, its process time charged to ``part`` (``before`` first, its
+    time charged to "wait")."""
+    def charged(*args, **kwargs):
+        if before is not None:
+            since = time.process_time()
+            before()
+            spent["wait"] += time.process_time() - since
+        since = time.process_time()
+        try:
+            return call(*args, **kwargs)
+        finally:
+            spent[part] += time.process_time() - since
+    return charged
 
-    def __init__(self) -> None:
-        self.since = time.process_time()
 
-    def charge(self, part: str) -> None:
-        now = time.process_time()
-        spent[part] += now - self.since
-        self.since = now
+class Timed:
+    """Forwards every attribute of ``target``; the methods named in ``parts``
+    come timed (:func:`timed`)."""
+
+    def __init__(self, target, parts: dict[str, str], before: Optional[Callable] = None):
+        self._target, self._parts, self._before = target, parts, before
+
+    def __getattr__(self, name: str):
+        value = getattr(self._target, name)
+        part = self._parts.get(name)
+        return value if part is None else timed(value, part, self._before)
 
 
-def timed_assemble(self, A, model, state, active, mask, configuration, friction=None) -> bool:
-    """``AssembledEntry.assemble`` without friction, part by part."""
-    if friction is not None:
-        raise NotImplementedError("this benchmark times the frictionless Jacobian only")
-    clock = Clock()
-    geometric = configuration.geometric_stiffness(active, self.comm)
-    clock.charge("geometric")
-    K = model.jacobian(state, active, mask, geometric=geometric)
-    clock.charge("product")
-    self.stiffened_rows = entry.stiffened_rows(K, self.bs)
-    clock.charge("stiffened_rows")
-    changed = configuration.add_stiffness(A, K)
-    clock.charge("add_stiffness")
-    self.comm.Barrier()
-    clock.charge("wait")
-    A.assemble()
-    clock.charge("assemble")
-    return changed
+def timed_entry(assemble: Callable) -> Callable:
+    """``AssembledEntry.assemble`` as it is, called with timed stand-ins for the
+    model, the configuration and the matrix it adds into."""
+    def charged(self, A, model, state, active, mask, configuration, friction=None):
+        return assemble(self, Timed(A, {"assemble": "assemble"}, before=self.comm.Barrier),
+                        Timed(model, {"jacobian": "product"}), state, active, mask,
+                        Timed(configuration, {"geometric_stiffness": "geometric",
+                                              "add_stiffness": "add_stiffness"}), friction)
+    return charged
 
 
 def main(argv=None) -> None:
-    entry.AssembledEntry.assemble = timed_assemble
+    entry.AssembledEntry.assemble = timed_entry(entry.AssembledEntry.assemble)
+    entry.stiffened_rows = timed(entry.stiffened_rows, "stiffened_rows")
     contact_ranks.main(argv)
     comm = MPI.COMM_WORLD
     rows = comm.gather(dict(spent))

@@ -7,6 +7,8 @@ import sys
 import pytest
 from mpi4py import MPI
 
+from support import child_environment
+
 SCRIPT = """
 import logging
 root = logging.getLogger()
@@ -27,8 +29,7 @@ print(dolfinx_mortar.__version__)
 def test_import_leaves_the_root_logger_alone_and_lists_the_main_classes():
     # a fresh interpreter: this one has imported the library long ago
     run = subprocess.run([sys.executable, "-P", "-c", SCRIPT], capture_output=True, text=True,
-                         timeout=300, env={k: v for k, v in __import__("os").environ.items()
-                                           if not k.startswith(("OMPI_", "PMIX_"))})
+                         timeout=300, env=child_environment())
     assert run.returncode == 0, run.stderr
     assert run.stdout.strip()
 
@@ -47,8 +48,7 @@ def test_warnings_are_shown_after_dolfinx_is_imported():
     NullHandler: a script saw none of the library's warnings in Debian 13 (pytest,
     which catches them itself, did). Python's default shows them once on stderr."""
     run = subprocess.run([sys.executable, "-P", "-c", WARNING], capture_output=True, text=True,
-                         timeout=300, env={k: v for k, v in __import__("os").environ.items()
-                                           if not k.startswith(("OMPI_", "PMIX_"))})
+                         timeout=300, env=child_environment())
     assert run.returncode == 0, run.stderr
     assert "RuntimeWarning: the contact misses them" in run.stderr
 
@@ -89,10 +89,7 @@ def test_a_warning_of_all_ranks_is_shown_once_and_issued_on_each():
     warnings ("always", "error", pytest.warns) sees on every rank, so that an
     error raises on all of them together. A warning names the user's line that
     called into the library."""
-    env = {k: v for k, v in __import__("os").environ.items()
-           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "PMI_"))}
-    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_btl="self,sm", OMP_NUM_THREADS="1")
+    env = {**child_environment(), "OMPI_MCA_btl": "self,sm"}   # the Makefile's transport
     run = subprocess.run(["mpirun", "-n", "2", "--oversubscribe", sys.executable, "-P", "-c",
                           SHOWN_ONCE], capture_output=True, text=True, timeout=300, env=env)
     assert run.returncode == 0, run.stderr

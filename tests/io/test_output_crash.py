@@ -23,6 +23,7 @@ from petsc4py import PETSc
 from dolfinx_mortar.contact.obstacles import RigidPlane
 from dolfinx_mortar import ContactProblem
 from dolfinx_mortar.io.surface_output import surface_output_path
+from support import child_environment
 from support.scenes import block_on_plane
 
 CHILD = Path(__file__).resolve().parent / "output_child.py"
@@ -92,18 +93,6 @@ def test_output_index_names_only_readable_data(tmp_path_factory):
     with io.XDMFFile(MPI.COMM_WORLD, str(folder / "block.xdmf"), "r") as f:
         mesh = f.read_mesh()
     assert mesh.topology.index_map(2).size_global == problem.mesh.topology.index_map(2).size_global
-
-
-def child_environment() -> dict:
-    """The environment for a child run: no trace of this process's MPI job (a
-    child of an mpirun rank would otherwise try to join that job). The child
-    imports the installed package, as this process does: the checkout is not put
-    on its path (it has no compiled kernels)."""
-    env = {k: v for k, v in os.environ.items()
-           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "HYDRA_", "PMI_"))}
-    env["OMP_NUM_THREADS"] = "1"
-    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    return env
 
 
 def kill_during_run(command: list, delay: float) -> None:

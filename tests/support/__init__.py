@@ -5,6 +5,7 @@ tests load them with the one loader of demo_support.scripts.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -26,5 +27,16 @@ POINTWISE_WITH_A_DUAL_KIND = pytest.mark.filterwarnings(
     "ignore:the pointwise active set with a dual kind:RuntimeWarning")
 
 
+def child_environment() -> dict:
+    """The environment for a child run: no trace of this process's MPI job (a
+    child of an mpirun rank would otherwise try to join that job). The child
+    imports the package as this process does (the same PYTHONPATH)."""
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "HYDRA_", "PMI_"))}
+    env["OMP_NUM_THREADS"] = "1"
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    return env
+
+
 __all__ = ["REPO_ROOT", "DEMOS", "BENCHMARKS", "LOW_PENALTY", "POINTWISE_WITH_A_DUAL_KIND",
-           "load_demo", "load_script"]
+           "child_environment", "load_demo", "load_script"]

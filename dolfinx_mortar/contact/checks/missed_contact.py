@@ -180,8 +180,7 @@ class MissedContact:
         futile = radius >= 2.0 * motion
         if futile or self.widenings >= MAX_MISSED_WIDENINGS:
             self._warned = True
-            warn(self._missed_for_good(count, ratio, depth, where, futile),
-                 term.comm)
+            warn(self._missed_for_good(count, ratio, depth, where, futile), term.comm)
             return None
         self.widenings += 1
         wider = max(4.0 * radius, reach)

@@ -6,7 +6,6 @@ failures blamed on the load or on a master out of reach).
 """
 from __future__ import annotations
 
-
 import numpy as np
 from mpi4py import MPI
 
