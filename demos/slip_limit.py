@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import argparse
 import time
-from typing import Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 from mpi4py import MPI
@@ -52,6 +52,10 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
                         help="ε_T as a multiple of E/h_block (default: the library's, ε/10)")
     parser.add_argument("--load-steps", type=int, default=4, help="steps applying G (4)")
     parser.add_argument("--push-steps", type=int, default=12, help="steps of the push (12)")
+    parser.add_argument("--load-path", type=float, nargs="+", default=None,
+                        help="the load factors t of the steps, increasing to 1, in place of "
+                             "the equal steps of --load-steps and --push-steps (t ≤ share: "
+                             "the load G; then the push); to repeat another run's path")
     parser.add_argument("--output", default=None, help="XDMF file for the steps")
     parser.add_argument("--json", default=None, help="write the key figures as JSON here")
     return parse_args_and_petsc_options(parser, argv)
@@ -106,6 +110,21 @@ def exact_ratio(tan_alpha: float, mu: float) -> float:
     return (tan_alpha + mu) / (1 - mu * tan_alpha)
 
 
+def load_path(args: argparse.Namespace) -> Callable[[float], float]:
+    """The load factor t at the solver's pseudo-time s: t = s for equal steps;
+    with ``--load-path`` t₁ < … < 1, t is linear in s between s = k/n and
+    t_k, so that the solver's n equal steps land on them (and a cut-back
+    between two of them halves that step)."""
+    if args.load_path is None:
+        return lambda s: s
+    ts = np.asarray(args.load_path, dtype=float)
+    if ts.ndim != 1 or ts[0] <= 0 or np.any(np.diff(ts) <= 0) or ts[-1] != 1.0:
+        raise ValueError(f"--load-path must increase from above 0 to 1, got {args.load_path}")
+    s_points = np.arange(len(ts) + 1) / len(ts)
+    t_points = np.concatenate([[0.0], ts])
+    return lambda s: float(np.interp(s, s_points, t_points))
+
+
 def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     import ufl
     from dolfinx import fem
@@ -139,8 +158,10 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     problem = NonlinearContactProblem(F, u, contact, bcs)
     solver = LoadPathSolver(problem)
     share = args.load_steps / (args.load_steps + args.push_steps)
+    path = load_path(args)
 
-    def update(t: float) -> None:
+    def update(s: float) -> None:
+        t = path(s)
         load.value = args.load * min(t / share, 1.0)
         push.value = args.push * max(t - share, 0.0) / (1 - share)
 
@@ -149,7 +170,7 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
     def record(step) -> None:
         C = contact.results.contact_force()
         summary = step.friction[0]
-        rows.append({"t": step.load_factor, "push": float(push.value),
+        rows.append({"t": path(step.load_factor), "push": float(push.value),
                      "F": float(-C[0]), "G": float(C[1]),
                      "ratio": float(-C[0] / C[1]) if C[1] > 0 else 0.0,
                      "stick_nodes": summary["stick_nodes"], "slip_nodes": summary["slip_nodes"],
@@ -157,7 +178,8 @@ def run(args: argparse.Namespace, comm: MPI.Comm) -> dict:
                      "newton_iterations": step.newton_iterations,
                      "terminal_iterations": step.terminal_iterations()})
 
-    result = solver.solve(update, load_steps=args.load_steps + args.push_steps,
+    steps = args.load_steps + args.push_steps if args.load_path is None else len(args.load_path)
+    result = solver.solve(update, load_steps=steps,
                           output=args.output, on_step=record)
     wall = time.perf_counter() - clock
     last = rows[-1]

@@ -183,11 +183,11 @@ class ContactTerm:
         return True
 
     def begin_step(self) -> bool:
-        """Called by a load-path driver when a load step starts. With
-        ``basis_configuration="previous"`` the bases (and segmentation) are
-        rebuilt in the configuration of the last converged step if u moved
-        since; returns True then (the pattern may change: :meth:`create_matrix`)."""
+        """An attempt at a load step starts ("previous": the bases rebuilt where the last
+        converged step left u; then True, the pattern may change: :meth:`create_matrix`)."""
         self._newton.near_contact.reset()
+        if self.friction is not None:
+            self.friction.begin_attempt()
         clock = time.perf_counter()
         return self._take(self._configuration.begin_step(self.options, self.u), clock)
 

@@ -102,11 +102,14 @@ class Friction:
             nodal_displacement(slave, u),
             None if obstacle is None else np.array(obstacle.displacement, dtype=float))
         self._operator: Optional[SlipOperator] = None
-        #: the stick/slip states and slip directions of the last Jacobian (the
-        #: exact slip tangent once they repeat)
+        #: the states and slip directions of the last Jacobian (exact once states repeat)
         self._jacobian_states: Optional[tuple[npt.NDArray[np.int8], FloatArray]] = None
         #: the source and the step the slip operator was made for
         self._operator_for: tuple = (None, -2)
+
+    def begin_attempt(self) -> None:
+        """An attempt at a load step starts on the secant (docs/FRICTION.md)."""
+        self._jacobian_states = None
 
     def _slip_operator(self, source: GapSource) -> SlipOperator:
         """The slip operator of the present step: made again for a new source,
