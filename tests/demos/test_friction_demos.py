@@ -110,6 +110,28 @@ def test_cattaneo_mindlin_lcls_star_on_the_current_surface():
     assert f["cut_backs"] == 0
 
 
+def slip_limit_rows_on_all_ranks_and_one(argv, path=None):
+    """The slip-limit demo's rows on COMM_WORLD and on COMM_SELF, on the load
+    path ``path`` (the demo's ``--load-path``) or in its equal steps."""
+    demo = load_demo("slip_limit")
+    extra = [] if path is None else ["--load-path", *map(repr, path)]
+    return [demo.run(demo.parse_args(argv + extra), comm)["steps"]
+            for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)]
+
+
+def assert_same_rows(rows):
+    paths = [[row["t"] for row in steps] for steps in rows]
+    assert paths[0] == paths[1], f"the runs took different load paths: {paths}"
+    for a, b in zip(*rows):
+        assert a["F"] == pytest.approx(b["F"], rel=1e-8, abs=1e-14)
+        assert a["G"] == pytest.approx(b["G"], rel=1e-8)
+        assert (a["stick_nodes"], a["slip_nodes"]) == (b["stick_nodes"], b["slip_nodes"])
+        assert a["dissipation"] == pytest.approx(b["dissipation"], rel=1e-6, abs=1e-16)
+
+
+SLIP_LIMIT_ARGV = ["--tan-alpha", "0.2", "--mu", "0.3", "--push-steps", "4"]
+
+
 @pytest.mark.parametrize("configuration", ["initial", "current"])
 def test_slip_limit_same_on_one_and_all_ranks(configuration):
     """The same steps on all ranks and on one, to round-off, on the same load path.
@@ -121,28 +143,24 @@ def test_slip_limit_same_on_one_and_all_ranks(configuration):
     (sid, 2 ranks) another CPU's round-off made Newton cycle at t = 0.625
     with μ = 0.3, the step was cut back there only, and the rows were
     compared out of step."""
-    demo = load_demo("slip_limit")
-    argv = ["--tan-alpha", "0.2", "--mu", "0.3", "--push-steps", "4",
-            "--basis-configuration", configuration]
-    world, alone = MPI.COMM_WORLD, MPI.COMM_SELF
-
-    def rows_on(path=None):
-        extra = [] if path is None else ["--load-path", *map(repr, path)]
-        return [demo.run(demo.parse_args(argv + extra), comm)["steps"] for comm in (world, alone)]
-
-    rows = rows_on()
+    argv = SLIP_LIMIT_ARGV + ["--basis-configuration", configuration]
+    rows = slip_limit_rows_on_all_ranks_and_one(argv)
     paths = [[row["t"] for row in steps] for steps in rows]
     # the runs on this communicator are the same on every rank; rank 0 decides
-    if world.bcast(paths[0] != paths[1]):
-        union = world.bcast(sorted({round(t, 12) for path in paths for t in path}))
-        rows = rows_on(union)
-        paths = [[row["t"] for row in steps] for steps in rows]
-        assert paths[0] == paths[1], f"the runs left the common load path {union}: {paths}"
-    for a, b in zip(*rows):
-        assert a["F"] == pytest.approx(b["F"], rel=1e-8, abs=1e-14)
-        assert a["G"] == pytest.approx(b["G"], rel=1e-8)
-        assert (a["stick_nodes"], a["slip_nodes"]) == (b["stick_nodes"], b["slip_nodes"])
-        assert a["dissipation"] == pytest.approx(b["dissipation"], rel=1e-6, abs=1e-16)
+    if MPI.COMM_WORLD.bcast(paths[0] != paths[1]):
+        union = MPI.COMM_WORLD.bcast(sorted({round(t, 12) for path in paths for t in path}))
+        rows = slip_limit_rows_on_all_ranks_and_one(argv, union)
+    assert_same_rows(rows)
+
+
+def test_slip_limit_on_a_cut_back_path_same_on_one_and_all_ranks():
+    """The path of the step cut back at t = 0.625 (one more step, at
+    0.5625), given as ``--load-path``: the runs take exactly those steps and
+    agree to round-off, as the test above needs where its runs' paths differ."""
+    path = [0.125, 0.25, 0.375, 0.5, 0.5625, 0.625, 0.75, 0.875, 1.0]
+    rows = slip_limit_rows_on_all_ranks_and_one(SLIP_LIMIT_ARGV, path)
+    assert [row["t"] for row in rows[0]] == pytest.approx(path, abs=1e-14)
+    assert_same_rows(rows)
 
 
 def test_cattaneo_mindlin_same_on_one_and_all_ranks():
