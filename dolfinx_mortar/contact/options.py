@@ -8,7 +8,7 @@ import numpy as np
 
 from dolfinx_mortar.collective_warnings import warn
 from dolfinx_mortar.contact.laws import PenaltyLaw
-from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, is_global, parse_kind
+from dolfinx_mortar.kinds import DUAL_KINDS, BasisKind, KindLike, parse_kind
 
 CONFIGURATIONS = ("initial", "previous", "current")
 
@@ -124,9 +124,4 @@ def check_self_contact(kind: BasisKind, basis_configuration: str, pointwise: boo
             "passes meet at the contact edge the negative dual functions make the pressure "
             "1.6% off its mirror problem (tests/contact/test_self_contact.py); use "
             "active_set='nodal' or kind='LmLS*'")
-    if is_global(kind):
-        raise NotImplementedError(
-            "self_contact=True with a GLS kind: its L couples every facet of the surface, "
-            "and a surface that pairs with itself has not been verified with it; use a local "
-            "kind (LcLS*, LcLS, LmLS*, LmLS)")
 

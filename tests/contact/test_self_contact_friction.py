@@ -49,7 +49,7 @@ def sheared(kind: str, configuration: str, slide: bool) -> ContactProblem:
 
 
 @pytest.mark.parametrize("slide", [False, True], ids=["stick", "slip"])
-@pytest.mark.parametrize("kind", ["LcLS*", "LcLS", "LmLS*", "LmLS"])
+@pytest.mark.parametrize("kind", ["LcLS*", "LcLS", "LmLS*", "LmLS", "GLS*", "GLS"])
 def test_a_sheared_stack_in_self_contact_carries_the_uniform_traction(kind, slide):
     """Non-matching faces (8 and 11 cells) in one self-contact term with
     friction: every node of both faces carries the pressure Q and the

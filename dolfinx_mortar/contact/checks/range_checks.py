@@ -25,7 +25,7 @@ from dolfinx_mortar.contact.checks.thresholds import (BODY_PENETRATION, DEEP_PEN
                                                       SLIP_LIMIT, SUGGESTED_PENETRATION)
 from dolfinx_mortar.contact.gap_sources import pairing_options
 from dolfinx_mortar.contact.state import ContactState
-from dolfinx_mortar.kinds import DUAL_KINDS
+from dolfinx_mortar.kinds import DUAL_KINDS, is_global
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
@@ -121,7 +121,7 @@ class RangeChecks:
         covered = state.covered & on_local_cell
         ratio, gap, x = self.term.results.deepest(np.where(covered, state.gaps, -np.inf))
         if self.term.options.self_contact:
-            refuse_a_self_overlap(ratio, gap, x)
+            refuse_a_self_overlap(ratio, gap, x, is_global(self.term.options.kind))
         if ratio > DEEP_PENETRATION:
             hint = ""
             options = self.term.options

@@ -87,17 +87,27 @@ def check_initial_overlap(term, coupling, built_at_u: bool) -> None:
         return
 
 
-def refuse_a_self_overlap(ratio: float, depth: float, where: list) -> None:
+def refuse_a_self_overlap(ratio: float, depth: float, where: list,
+                          global_kind: bool = False) -> None:
     """A self-contact surface whose deepest node (``ratio`` element lengths, ``depth``,
     at ``where``; the same on every rank) lies more than DEEP_PENETRATION inside the
-    body at the start is refused: with two bodies it is warned about only."""
+    body at the start is refused: with two bodies it is warned about only.
+    ``global_kind``: the term's kind is GLS or GLS*, whose ``L⁻¹`` can read such
+    a depth where no overlap is (the message says so)."""
     if ratio > DEEP_PENETRATION:
+        hint = ("; with a GLS kind it is also what a node reads where its own surface "
+                "covers its facets over a sliver only: the covered part's L is nearly "
+                "singular there and L⁻¹ amplifies that piece's gap (the C slab in 3D: a "
+                "node 1% covered read about 7 element lengths deep where LmLS* reads it 1.4 "
+                "element lengths apart; docs/SELF_CONTACT.md): a local kind reads the "
+                "true gap"
+                if global_kind else "")
         raise ValueError(f"the surface overlaps itself at the start: the node {where} lies "
                          f"{depth:.3g} ({ratio:.3g} element lengths) inside the body's own "
                          "surface. A self-contact surface must start without overlaps: "
                          "check the geometry and the tag; or a wall of the body thinner "
                          "than the search radius pairs with its own other side through "
-                         "the material: pass a search_radius below the wall's thickness")
+                         f"the material: pass a search_radius below the wall's thickness{hint}")
 
 
 #: a penalty below this many times E/h is refused where E is known

@@ -17,7 +17,9 @@ from mpi4py import MPI
 from dolfinx_mortar.contact.gap_sources.current import CurrentMortarGap
 from dolfinx_mortar.contact.gap_sources.current import CurrentObstacleGap
 from dolfinx_mortar.contact.gap_sources.frozen import MortarGap, ObstacleGap
-from dolfinx_mortar.contact.gap_sources.self_contact import CurrentSelfContactGap, SelfContactGap
+from dolfinx_mortar.contact.gap_sources.self_contact import (CurrentSelfContactGap,
+                                                             SelfContactGap,
+                                                             SelfContactGlobalGap)
 from dolfinx_mortar.contact.gap_sources.global_gap import GlobalGap, covered_mass
 from dolfinx_mortar.contact.laws import safe_weights
 from dolfinx_mortar.contact.obstacles import RigidObstacle
@@ -73,7 +75,9 @@ def frozen_model(options: ContactOptions, slave: LagrangeSurface,
                        boundary_modification=options.boundary_modification)
         mass = covered_mass(coupling) if is_global(options.kind) else None
     if is_global(options.kind):
-        return GlobalGap(model, law, mass)
+        # a self-contact surface's global L is that of the surface against itself,
+        # over the part its own other side covers (both passes share it)
+        return (SelfContactGlobalGap if options.self_contact else GlobalGap)(model, law, mass)
     return model
 
 

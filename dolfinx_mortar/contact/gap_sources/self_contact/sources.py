@@ -23,11 +23,13 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact.gap_sources.current import CurrentMortarGap
 from dolfinx_mortar.contact.gap_sources.frozen import MortarGap
+from dolfinx_mortar.contact.gap_sources.global_gap import GlobalGap
 from dolfinx_mortar.contact.gap_sources.self_contact.two_pass import (TwoPassPressures,
                                                                       half_penalty)
 from dolfinx_mortar.contact.laws import PenaltyLaw
 from dolfinx_mortar.contact.state import ContactState
 from dolfinx_mortar.kinds import BasisKind
+from dolfinx_mortar.layout import MassMatrixSolver
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.mortar.surface_normals import averaged_nodal_normals
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
@@ -51,6 +53,26 @@ class SelfContactGap(TwoPassPressures, MortarGap):
         """The segmentation's nodal normals and ``W_A = ∫ N_A`` over the whole
         surface (frozen with the bases; not the covered part's)."""
         return self.coupling.normals, self.basis.lumped_weights
+
+
+class SelfContactGlobalGap(TwoPassPressures, GlobalGap):
+    """GLS and GLS* on a surface against itself, two-pass: ``d̄ = L⁻¹ĝ`` of each
+    node's own pass, with ``L`` over the covered part of the whole surface.
+
+    ``inner`` is the :class:`SelfContactGap` of kind LmLS* that gives ``ĝ`` and
+    ``Ĝ`` (already with the half penalty), ``law`` the term's law (halved here,
+    as the potential's own weights ``ω_A`` come from it). A node reports its
+    own pass's pressure times two (``D̄ = L`` is not diagonal, so the force it
+    receives over ``W_A`` would be a smoothed pressure).
+    """
+
+    def __init__(self, inner: SelfContactGap, law: PenaltyLaw,
+                 mass: tuple[MassMatrixSolver, FloatArray]):
+        super().__init__(inner, half_penalty(law), mass)
+
+    @property
+    def _reports_received(self) -> bool:
+        return False
 
 
 class CurrentSelfContactGap(TwoPassPressures, CurrentMortarGap):
