@@ -18,6 +18,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar import dolfinx_compat
 from dolfinx_mortar.collective_warnings import deciding
+from dolfinx_mortar.linalg.petsc_library import petsc_library
 from dolfinx_mortar.tolerance import length_scale, zero_length
 
 
@@ -220,23 +221,13 @@ def _bad_cells_message(mesh: dolfinx.mesh.Mesh) -> Optional[str]:
     return None
 
 
-def _petsc_library() -> Optional[ctypes.CDLL]:
-    major, minor, _ = PETSc.Sys.getVersion()
-    for name in (f"libpetsc_real.so.{major}.{minor}", f"libpetsc.so.{major}.{minor}"):
-        try:
-            return ctypes.CDLL(name)
-        except OSError:
-            continue
-    return None
-
-
 def _option_used_query() -> Optional[Callable[[str], bool]]:
     """``name -> whether an object read the option`` (name without the '-')."""
     db = PETSc.Options()
     if hasattr(db, "used"):            # petsc4py 3.25 (not 3.22)
         return lambda name: bool(db.used(name))
     # older petsc4py: PetscOptionsUsed of the library petsc4py itself loaded
-    lib = _petsc_library()
+    lib = petsc_library()
     if lib is None:
         return None
     query = lib.PetscOptionsUsed

@@ -7,6 +7,8 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.linalg.in_place_add import InPlaceAdd
+
 
 def transpose_mat_mult(A: PETSc.Mat, B: PETSc.Mat) -> PETSc.Mat:
     """``Aᵀ B`` as a new matrix.
@@ -91,9 +93,9 @@ class PatternTrackingAdd:
     Added with SUBSET_NONZERO_PATTERN, every entry of ``K`` that ``A`` lacks
     is a malloc inside PETSc, and each one reallocates the row storage: 2.3 s
     for one Jacobian of Hertz 3D at 30k dofs, ten times the bulk assembly.
-    When ``K``'s pattern differs from the last one added (compared exactly,
-    on every rank), ``A`` is rebuilt once with the union pattern; otherwise
-    ``K``'s entries are already in ``A``. The rebuild keeps ``A``'s handle, so
+    Where ``K`` has an entry that ``A`` lacks (on any rank), ``A`` is rebuilt
+    once with the union pattern; otherwise ``K``'s values are added in place
+    (:class:`~dolfinx_mortar.linalg.in_place_add.InPlaceAdd`). The rebuild keeps ``A``'s handle, so
     SNES and the KSP keep using it; what the rebuild drops (the
     near-nullspace, the permission to allocate new entries) is put back.
 
@@ -108,28 +110,24 @@ class PatternTrackingAdd:
     """
 
     def __init__(self) -> None:
-        self._rows: Optional[np.ndarray] = None
-        self._cols: Optional[np.ndarray] = None
+        self._in_place = InPlaceAdd()
 
     def __call__(self, A: PETSc.Mat, K: PETSc.Mat) -> bool:
-        rows, cols, _ = K.getValuesCSR()
-        same = (self._rows is not None and np.array_equal(rows, self._rows)
-                and np.array_equal(cols, self._cols))
-        # MatAXPY is collective: every rank must take the same branch
-        if A.getComm().tompi4py().allreduce(bool(same), op=MPI.LAND):
-            A.axpy(1.0, K, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        # every entry of K already in A (the pattern of an earlier add, or a
+        # subset of the union): the values only, in place
+        if self._in_place(A, K):
             return False
         nullspace = A.getNearNullSpace()
         A.axpy(1.0, K, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         if nullspace is not None and nullspace.handle:
             A.setNearNullSpace(nullspace)
-        self._rows, self._cols = rows.copy(), cols.copy()
+        self._in_place.reset()
         return True
 
     def reset(self) -> None:
-        """Forget the last pattern (the next add rebuilds ``A``'s pattern)."""
-        self._rows = self._cols = None
+        """Forget the last patterns (the positions are found again)."""
+        self._in_place.reset()
 
 
 def kron_identity(L: PETSc.Mat, bs: int) -> PETSc.Mat:

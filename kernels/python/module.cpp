@@ -8,6 +8,7 @@
 #include <dolfinx_mortar/element_integrals.h>
 #include <dolfinx_mortar/facet_element.h>
 #include <dolfinx_mortar/geometric_tolerance.h>
+#include <dolfinx_mortar/sparse_pattern.h>
 #include <dolfinx_mortar/surface_geometry.h>
 
 #include "bindings.h"
@@ -41,11 +42,50 @@ tabulation_shape(const array_t& phi, const array_t& weights)
            static_cast<std::size_t>(phi.shape(2)) };
 }
 
+template<typename I>
+using exact_int_t = py::array_t<I, py::array::c_style>;
+
+/// positions_in_pattern for one index type of the outer pattern (PETSc's
+/// PetscInt: 32 bits in Debian's build, 64 in others); no copy of it.
+template<typename I>
+void
+bind_positions_in_pattern(py::module_& m)
+{
+  m.def(
+    "positions_in_pattern",
+    [](const exact_int_t<I>& outer_rows,
+       const exact_int_t<I>& outer_columns,
+       const int64_array_t& inner_rows,
+       const int64_array_t& inner_columns)
+      -> std::optional<py::array_t<std::int64_t>>
+    {
+      auto found = positions_in_pattern(
+        std::span<const I>(outer_rows.data(), outer_rows.size()),
+        std::span<const I>(outer_columns.data(), outer_columns.size()),
+        std::span<const std::int64_t>(inner_rows.data(), inner_rows.size()),
+        std::span<const std::int64_t>(inner_columns.data(),
+                                      inner_columns.size()));
+      if (!found)
+        return std::nullopt;
+      return to_numpy_as<std::int64_t>(
+        *found, { static_cast<py::ssize_t>(found->size()) });
+    },
+    py::arg("outer_rows"),
+    py::arg("outer_columns"),
+    py::arg("inner_rows"),
+    py::arg("inner_columns"),
+    "Index in outer_columns of each entry of the pattern inner (both CSR, "
+    "columns ascending in each row, the same rows), or None where one is "
+    "not in outer");
+}
+
 } // namespace
 
 PYBIND11_MODULE(_kernels, m)
 {
   m.doc() = "dolfinx_mortar C++ kernels";
+  bind_positions_in_pattern<std::int32_t>(m);
+  bind_positions_in_pattern<std::int64_t>(m);
   bind_current_surface(m);
 
   m.attr("geometric_tolerance") = geometric_tolerance;

@@ -1,11 +1,13 @@
 """Sparse products and adds of the contact stiffness (PatternTrackingAdd,
-TransposeProduct, kron_identity), on 1 and 2 ranks."""
+InPlaceAdd, TransposeProduct, kron_identity), on 1 and 2 ranks."""
 from __future__ import annotations
 
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.linalg import aij_blocks
+from dolfinx_mortar.linalg.in_place_add import InPlaceAdd
 from dolfinx_mortar.linalg.sparse_products import (PatternTrackingAdd, TransposeProduct,
                                                      kron_identity, transpose_mat_mult)
 
@@ -73,6 +75,48 @@ def test_new_entries_are_merged_once_and_the_near_nullspace_is_kept():
     # entries outside A's pattern still allocate as they come afterwards
     A.setValue(A.getOwnershipRange()[0], N - 1, 1.0, addv=PETSc.InsertMode.ADD_VALUES)
     A.assemble()
+
+
+def test_in_place_add_writes_into_both_blocks_and_refuses_entries_the_pattern_lacks():
+    """K's entries land in A's diagonal and off-diagonal blocks (the far
+    coupling crosses the ranks' column ranges), with new values on the same
+    pattern, a new pattern inside A's, and nothing added where K has an entry
+    A lacks on one rank only."""
+    A = _laplacian()
+    assert aij_blocks.supports(A)      # Debian's PETSc: the fast path is the one taken
+    add = PatternTrackingAdd()
+    assert add(A, _far_coupling(17, 0.5))           # A gains K's pattern once
+    A.assemble()
+    expected = _dense(A)
+    in_place = InPlaceAdd()
+    for K in (_far_coupling(17, 0.25), _far_coupling(17, -2.0), _laplacian(),
+              _far_coupling(17, 3.0)):
+        before = A.getInfo()["nz_used"]
+        assert in_place(A, K)
+        A.assemble()
+        expected += _dense(K)
+        assert np.max(np.abs(_dense(A) - expected)) <= 1e-14 * np.max(np.abs(expected))
+        assert A.getInfo()["nz_used"] == before and _mallocs(A) == 0
+    # one entry outside A's pattern, on the last rank's rows alone
+    lacking = _matrix([(N - 1, 0, 1.0), (N - 1, N - 1, 1.0)], 2)
+    assert not in_place(A, lacking)
+    A.assemble()
+    assert np.array_equal(_dense(A), expected)
+
+
+def test_the_newton_matrix_after_a_rebuild_takes_in_place_adds_again():
+    """After PatternTrackingAdd rebuilt A (new storage), the positions are
+    found again: the adds that follow are exact, and report no new pattern."""
+    A = _laplacian()
+    add = PatternTrackingAdd()
+    expected = _dense(A)
+    for K, changed in ((_far_coupling(17, 1.0), True), (_far_coupling(17, 2.0), False),
+                       (_far_coupling(23, 1.0), True), (_far_coupling(17, 4.0), False),
+                       (_far_coupling(23, 8.0), False)):
+        assert add(A, K) == changed
+        A.assemble()
+        expected += _dense(K)
+        assert np.max(np.abs(_dense(A) - expected)) <= 1e-14 * np.max(np.abs(expected))
 
 
 def _lu(A: PETSc.Mat) -> PETSc.KSP:

@@ -36,7 +36,6 @@ from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
 from dolfinx_mortar.surfaces.lagrange import LagrangeSurface
 
 FloatArray = npt.NDArray[np.float64]
-SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
 
 
 class InitialConfiguration:
@@ -63,6 +62,8 @@ class InitialConfiguration:
         #: displacement vector they are linearized about (None: zero)
         self.built_at: Optional[FloatArray] = None
         self.built_vector: Optional[PETSc.Vec] = None
+        #: adds K to the Newton matrix (in place where its entries are there)
+        self._add = PatternTrackingAdd()
 
     def build(self, options: ContactOptions, u) -> GapSource:
         """The gap model where the term is made (u: the displacement Function)."""
@@ -95,12 +96,13 @@ class InitialConfiguration:
 
     def add_stiffness(self, A: PETSc.Mat, K: PETSc.Mat) -> bool:
         """``A += K``; returns whether A's nonzero pattern changed in a way PETSc
-        does not see (the KSP must then be reset)."""
-        A.axpy(1.0, K, structure=SUBSET)
-        return False
+        does not see (the KSP must then be reset). The frozen configurations
+        made A with every entry K can have, so theirs never changes."""
+        return self._add(A, K)
 
     def new_matrix(self) -> None:
         """A new Newton matrix was made (its pattern holds every active set)."""
+        self._add.reset()
 
     def forget(self) -> None:
         """The state of the last evaluation no longer applies (a new model)."""
@@ -148,8 +150,6 @@ class CurrentConfiguration(InitialConfiguration):
                  obstacle: Optional[RigidObstacle]):
         super().__init__(slave, master, obstacle)
         self._last_active: Optional[FloatArray] = None
-        #: adds K to the Newton matrix, whose pattern the moving pairs change
-        self._add = PatternTrackingAdd()
         self._checked: Optional[MortarCoupling] = None
 
     def build(self, options: ContactOptions, u) -> GapSource:
@@ -184,12 +184,6 @@ class CurrentConfiguration(InitialConfiguration):
                                  op=MPI.LAND)
         self._last_active = active
         return settled
-
-    def add_stiffness(self, A: PETSc.Mat, K: PETSc.Mat) -> bool:
-        return self._add(A, K)
-
-    def new_matrix(self) -> None:
-        self._add.reset()
 
     def forget(self) -> None:
         self._last_active = None
