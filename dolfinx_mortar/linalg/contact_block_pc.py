@@ -192,9 +192,18 @@ def tell_preconditioner(ksp: PETSc.KSP, stiffened_rows: Sequence[np.ndarray],
     the contact changed the matrix's pattern in a way PETSc does not notice
     (:class:`~dolfinx_mortar.linalg.sparse_products.PatternTrackingAdd`), and,
     for a :class:`ContactBlockPreconditioner`, the rows the contact terms
-    stiffened (one array per term)."""
+    stiffened (one array per term).
+
+    A preconditioner whose last set-up failed is set up afresh too: MUMPS
+    keeps a failed factorization's state, and a new one on the same pattern
+    then fails its solve ("INFOG(1)=-3") however good the new matrix is. Each
+    new pattern used to reset it by chance; since the contact stiffness is
+    added in place (a new Newton attempt after a cut-back keeps the pattern),
+    nothing did, and the error escaped a load path on 2 ranks."""
     pc = ksp.getPC()
-    if pattern_changed:
+    failed = (pc.getFailedReason() != PETSc.PC.FailedReason.NOERROR
+              or ksp.getConvergedReason() == PETSc.KSP.ConvergedReason.DIVERGED_PCSETUP_FAILED)
+    if pattern_changed or failed:
         pc.reset()
     if pc.getType() == "python":
         context = pc.getPythonContext()

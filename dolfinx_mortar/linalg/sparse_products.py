@@ -7,6 +7,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from dolfinx_mortar.linalg import aij_blocks
 from dolfinx_mortar.linalg.in_place_add import InPlaceAdd
 
 
@@ -111,12 +112,25 @@ class PatternTrackingAdd:
 
     def __init__(self) -> None:
         self._in_place = InPlaceAdd()
+        #: K's pattern at the last rebuild, for matrices whose arrays cannot be reached
+        self._last: Optional[tuple[np.ndarray, np.ndarray]] = None
 
     def __call__(self, A: PETSc.Mat, K: PETSc.Mat) -> bool:
         # every entry of K already in A (the pattern of an earlier add, or a
         # subset of the union): the values only, in place
-        if self._in_place(A, K):
-            return False
+        if aij_blocks.supports(A) and aij_blocks.supports(K):
+            if self._in_place(A, K):
+                return False
+        else:
+            # not AIJ (a user's BAIJ matrix, say): K's pattern is compared with
+            # the last one merged, and PETSc adds the values
+            pattern = _pattern(K)
+            same = (self._last is not None and np.array_equal(pattern[0], self._last[0])
+                    and np.array_equal(pattern[1], self._last[1]))
+            if A.getComm().tompi4py().allreduce(bool(same), op=MPI.LAND):
+                A.axpy(1.0, K, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+                return False
+            self._last = pattern
         nullspace = A.getNearNullSpace()
         A.axpy(1.0, K, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
         A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
@@ -128,6 +142,7 @@ class PatternTrackingAdd:
     def reset(self) -> None:
         """Forget the last patterns (the positions are found again)."""
         self._in_place.reset()
+        self._last = None
 
 
 def kron_identity(L: PETSc.Mat, bs: int) -> PETSc.Mat:

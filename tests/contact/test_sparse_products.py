@@ -7,6 +7,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_mortar.linalg import aij_blocks
+from dolfinx_mortar.linalg.contact_block_pc import tell_preconditioner
 from dolfinx_mortar.linalg.in_place_add import InPlaceAdd
 from dolfinx_mortar.linalg.sparse_products import (PatternTrackingAdd, TransposeProduct,
                                                      kron_identity, transpose_mat_mult)
@@ -14,9 +15,13 @@ from dolfinx_mortar.linalg.sparse_products import (PatternTrackingAdd, Transpose
 N = 40
 
 
-def _matrix(entries, nnz: int) -> PETSc.Mat:
-    """An N × N AIJ matrix with the given (row, col, value) on this rank's rows."""
-    A = PETSc.Mat().createAIJ((N, N), nnz=(nnz, nnz), comm=MPI.COMM_WORLD)
+def _matrix(entries, nnz: int, blocked: bool = False) -> PETSc.Mat:
+    """An N × N AIJ matrix (BAIJ with blocks of 1 if ``blocked``) with the
+    given (row, col, value) on this rank's rows."""
+    if blocked:
+        A = PETSc.Mat().createBAIJ((N, N), 1, nnz=(nnz, nnz), comm=MPI.COMM_WORLD)
+    else:
+        A = PETSc.Mat().createAIJ((N, N), nnz=(nnz, nnz), comm=MPI.COMM_WORLD)
     start, end = A.getOwnershipRange()
     for i, j, v in entries:
         if start <= i < end:
@@ -119,6 +124,24 @@ def test_the_newton_matrix_after_a_rebuild_takes_in_place_adds_again():
         assert np.max(np.abs(_dense(A) - expected)) <= 1e-14 * np.max(np.abs(expected))
 
 
+def test_a_matrix_whose_arrays_are_not_reached_is_added_by_petsc():
+    """A BAIJ Newton matrix (not AIJ: no in-place add): the same sums, and A's
+    pattern is rebuilt only where K's pattern changed."""
+    entries = [(i, i, 4.0) for i in range(N)] + [(i, (i + 1) % N, -1.0) for i in range(N)]
+    A = _matrix(entries, 3, blocked=True)
+    A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    assert not aij_blocks.supports(A)
+    expected = _dense(A)
+    add = PatternTrackingAdd()
+    far = [(i, (i + 17) % N, 1.0 + i) for i in range(0, N, 3)]
+    for scale, changed in ((1.0, True), (2.0, False), (-0.5, False)):
+        K = _matrix([(i, j, scale * v) for i, j, v in far], 1, blocked=True)
+        assert add(A, K) == changed
+        A.assemble()
+        expected += _dense(K)
+        assert np.max(np.abs(_dense(A) - expected)) <= 1e-14 * np.max(np.abs(expected))
+
+
 def _lu(A: PETSc.Mat) -> PETSc.KSP:
     ksp = PETSc.KSP().create(MPI.COMM_WORLD)
     ksp.setOperators(A)
@@ -158,6 +181,34 @@ def test_a_changed_pattern_is_reported_and_a_reset_solver_solves_the_new_matrix(
     assert _relative_residual(ksp, A) < 1e-12
     assert not add(A, K)               # the same pattern again: only values
     A.assemble()
+    assert _relative_residual(ksp, A) < 1e-12
+
+
+def test_a_failed_factorization_is_set_up_afresh_for_the_next_matrix():
+    """MUMPS keeps a failed factorization's state: the next matrix on the same
+    pattern (a new Newton attempt after a cut-back, its stiffness added in
+    place) then failed its solve with INFOG(1) = -3 on 2 ranks. The solver is
+    told, and solves it."""
+    A = _laplacian()
+    start, end = A.getOwnershipRange()
+
+    def fill(singular: bool) -> None:
+        A.zeroEntries()
+        for i in range(start, end):
+            A.setValue(i, i, 0.0 if singular else 4.0)
+        A.assemble()
+
+    fill(False)
+    ksp = _lu(A)
+    assert _relative_residual(ksp, A) < 1e-12
+    fill(True)                         # every pivot zero: the factorization fails
+    b, x = A.createVecLeft(), A.createVecRight()
+    b.set(1.0)
+    ksp.solve(b, x)
+    assert ksp.getConvergedReason() == PETSc.KSP.ConvergedReason.DIVERGED_PCSETUP_FAILED
+    fill(False)
+    tell_preconditioner(ksp, [], pattern_changed=False)
+    ksp.setOperators(A)                # as SNES does after the Jacobian
     assert _relative_residual(ksp, A) < 1e-12
 
 
