@@ -31,6 +31,8 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 from petsc4py import PETSc
 
+from dolfinx_mortar.linalg.linear_solver import reset_after_failure
+
 #: the multigrid's options unless the options database has others
 AMG_DEFAULTS = {
     "ksp_type": "preonly",
@@ -194,16 +196,13 @@ def tell_preconditioner(ksp: PETSc.KSP, stiffened_rows: Sequence[np.ndarray],
     for a :class:`ContactBlockPreconditioner`, the rows the contact terms
     stiffened (one array per term).
 
-    A preconditioner whose last set-up failed is set up afresh too: MUMPS
-    keeps a failed factorization's state, and a new one on the same pattern
-    then fails its solve ("INFOG(1)=-3") however good the new matrix is. Each
+    A preconditioner whose last set-up failed is set up afresh too
+    (:func:`~dolfinx_mortar.linalg.linear_solver.reset_after_failure`). Each
     new pattern used to reset it by chance; since the contact stiffness is
     added in place (a new Newton attempt after a cut-back keeps the pattern),
-    nothing did, and the error escaped a load path on 2 ranks."""
+    nothing did, and MUMPS's error escaped a load path on 2 ranks."""
     pc = ksp.getPC()
-    failed = (pc.getFailedReason() != PETSc.PC.FailedReason.NOERROR
-              or ksp.getConvergedReason() == PETSc.KSP.ConvergedReason.DIVERGED_PCSETUP_FAILED)
-    if pattern_changed or failed:
+    if not reset_after_failure(ksp) and pattern_changed:
         pc.reset()
     if pc.getType() == "python":
         context = pc.getPythonContext()

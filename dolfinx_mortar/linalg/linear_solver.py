@@ -21,6 +21,8 @@ Every option stays overridable under the solver's prefix
 """
 from __future__ import annotations
 
+from petsc4py import PETSc
+
 LINEAR_SOLVERS = ("auto", "direct", "iterative")
 
 #: 3D problems from this many dofs on are solved iteratively by "auto". On
@@ -73,3 +75,20 @@ def choose_linear_solver(requested: str, num_dofs: int, gdim: int, augmented: bo
     if requested != "auto":
         return requested
     return "iterative" if gdim == 3 and num_dofs >= ITERATIVE_FROM_DOFS else "direct"
+
+
+def reset_after_failure(ksp: PETSc.KSP) -> bool:
+    """Reset ``ksp``'s preconditioner if its last set-up failed, so that the
+    next one starts afresh; returns whether it did (the operators must then
+    be set again, as SNES does after each Jacobian).
+
+    MUMPS keeps a failed factorization's state: the next numeric
+    factorization on the same pattern is followed by a solve that fails with
+    INFOG(1) = -3, or (where PETSc saw the failure) gives Inf, however good
+    the new matrix is."""
+    pc = ksp.getPC()
+    failed = (pc.getFailedReason() != PETSc.PC.FailedReason.NOERROR
+              or ksp.getConvergedReason() == PETSc.KSP.ConvergedReason.DIVERGED_PCSETUP_FAILED)
+    if failed:
+        pc.reset()
+    return failed

@@ -17,6 +17,7 @@ from petsc4py import PETSc
 
 from dolfinx_mortar.contact.gap_sources import GlobalGapSource
 from dolfinx_mortar.contact.state import ContactState
+from dolfinx_mortar.linalg.linear_solver import reset_after_failure
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -139,6 +140,9 @@ class AugmentedNewtonStep:
             self.ksp.getPC().setFactorSolverType("mumps")
             self.ksp.setOptionsPrefix(self.prefix)
             self.ksp.setFromOptions()
+        # a failed factorization (a sliver's nearly singular system) must not
+        # leave MUMPS's state to the next one: every later step would be Inf
+        reset_after_failure(self.ksp)
         self.ksp.setOperators(A)
         clock = time.perf_counter()
         self.ksp.setUp()
