@@ -5,10 +5,10 @@ facets sit where the bulk's partition put them: on the ironing scene one rank
 holds them all, and its segmentation (3.2 s of its 8.7 s of contact CPU at 16
 ranks) did not divide. Each candidate pair's segmentation reads only its slave
 cell's nodes and nodal normals and its master cell's nodes, so the candidates
-are dealt out in equal shares (by count, in rank order) with those, segmented
-where they land, and the pairs found come back to the rank that owns their
-slave facet, in the order of its candidates: what the kernel gives on one rank,
-computed by all of them.
+are dealt out in equal shares with those (a rank keeps what its share holds of
+its own: ``pair_share.dealt_items``), segmented where they land, and the pairs
+found come back to the rank that owns their slave facet, in the order of its
+candidates: what the kernel gives on one rank, computed by all of them.
 """
 from __future__ import annotations
 

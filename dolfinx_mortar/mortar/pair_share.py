@@ -4,9 +4,9 @@ Jets read (docs/DESIGN.md, §Parallel).
 The exact derivatives of the current configuration's gaps cost 25 (gradients)
 to 100–200 (Hessians) times a pair's values, and the pairs sit where the
 surfaces press, often on one rank. So each rank keeps the search and the values
-of its own slave facets' pairs, and their Jet work is dealt out: pair ``g`` of
-all ranks' pairs, in rank order, goes to the rank whose equal share holds it,
-with what the kernel reads for it — the pair's slave cell, the slave cells
+of its own slave facets' pairs, and their Jet work is dealt out in equal shares
+(a rank keeps what its share holds of its own pairs, the rest go to ranks short
+of theirs: :func:`dealt_items`), each pair with what the kernel reads for it — the pair's slave cell, the slave cells
 around its nodes and around the other nodes of their normal clusters (the
 averaged normals and their derivatives), and the pair's master cell. A rank
 receives its share of the work and the facets of that share, not both whole
@@ -103,8 +103,8 @@ def own_pairs(coupling: FoundPairs, which: Optional[npt.NDArray[np.bool_]] = Non
 
 def deal_evenly(coupling: FoundPairs, which: npt.NDArray[np.bool_],
                 *values: npt.NDArray) -> DealtPairs:
-    """All ranks' pairs where ``which`` is True, dealt out in equal shares (by
-    count, in rank order) with the facets they read and ``values`` (one row per
+    """All ranks' pairs where ``which`` is True, dealt out in equal shares (each
+    rank keeps what its share holds of its own: :func:`dealt_items`) with the facets they read and ``values`` (one row per
     kept pair). Collective."""
     comm: MPI.Comm = coupling.slave.layout.comm
     mine = own_pairs(coupling, which, *values)
@@ -119,12 +119,36 @@ def deal_evenly(coupling: FoundPairs, which: npt.NDArray[np.bool_],
 
 
 def share_owners(comm: MPI.Comm, count: int) -> IntArray:
-    """For each of this rank's ``count`` items, the rank whose equal share of
-    all ranks' items (by count, in rank order) holds it."""
-    counts = comm.allgather(count)
-    total, first = sum(counts), sum(counts[:comm.rank])
-    starts = np.array([total * r // comm.size for r in range(comm.size)])
-    return np.searchsorted(starts, first + np.arange(count), side="right") - 1
+    """For each of this rank's ``count`` items, the rank that takes it in equal
+    shares of all ranks' items (collective; see :func:`dealt_items`)."""
+    return dealt_items(comm.allgather(count), comm.rank)
+
+
+def dealt_items(counts: list[int], rank: int) -> IntArray:
+    """For each of ``rank``'s ``counts[rank]`` items, the rank that takes it
+    when all ranks' items are dealt in equal shares (differing by one at most).
+
+    Each rank keeps as many of its own items as its share holds (the first
+    ones), and only the rest travel, in rank order, to the ranks whose own
+    items fall short of their shares. Dealing by position in rank order instead
+    sent a busy rank's items away while others' came in: at 16 ranks on Hertz
+    3D the busiest rank received its candidates' pairs back and 174 kB of
+    other ranks' candidates besides (docs/SCALING.md).
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    size = len(counts)
+    total = int(counts.sum())
+    shares = np.diff(np.array([total * r // size for r in range(size + 1)]))
+    kept = np.minimum(counts, shares)
+    excess, deficit = counts - kept, shares - kept
+    # where each rank's excess starts among all excess items, and each rank's
+    # deficit among all free places: the excess fills them in rank order
+    excess_first = int(excess[:rank].sum())
+    deficit_first = np.concatenate([[0], np.cumsum(deficit)[:-1]])
+    owners = np.full(int(counts[rank]), rank, dtype=np.int64)
+    moved = excess_first + np.arange(int(excess[rank]))
+    owners[int(kept[rank]):] = np.searchsorted(deficit_first, moved, side="right") - 1
+    return owners
 
 
 def needed_slave_cells(copy: SurfaceCopy, pair_cells: npt.NDArray,

@@ -11,7 +11,7 @@ from mpi4py import MPI
 from demo_support.self_mirror import CONTACT, build
 from dolfinx import fem
 from dolfinx_mortar.mortar.coupling import MortarCoupling, polynomial_degree, segment_quadrature
-from dolfinx_mortar.mortar.pair_share import deal_evenly, own_pairs
+from dolfinx_mortar.mortar.pair_share import deal_evenly, dealt_items, own_pairs
 from dolfinx_mortar.mortar.surface_exchange import bisected_boxes
 from dolfinx_mortar.surfaces.facet_surface import facet_surface
 from support.meshes import MASTER, SLAVE, two_blocks
@@ -143,8 +143,12 @@ def test_segmentation_dealt_out_gives_each_rank_the_pairs_it_segments_itself(sce
     assert comm.allreduce(len(here.pairs)) > 0
     assert np.array_equal(here.pairs, dealt.pairs)
     assert here.failed_projections == dealt.failed_projections
-    # what travels for the segmentation is counted
-    assert (dealt.received_bytes > here.received_bytes) == (comm.size > 1)
+    # what travels for the segmentation is counted (where every rank's
+    # candidates are its share already, only the replies' counters travel)
+    counts = comm.allgather(here.num_candidates)
+    travel = any(np.any(dealt_items(counts, r) != r) for r in range(comm.size))
+    extra = comm.allreduce(dealt.received_bytes - here.received_bytes)
+    assert extra >= 0 and (extra > 64 * comm.size or not travel)
     for a, b in zip(here.raw_pairs + (here.area_pairs,), dealt.raw_pairs + (dealt.area_pairs,)):
         scale = comm.allreduce(float(np.max(np.abs(a), initial=0.0)), op=MPI.MAX)
         assert np.allclose(a, b, rtol=0, atol=1e-14 * scale)
@@ -153,6 +157,23 @@ def test_segmentation_dealt_out_gives_each_rank_the_pairs_it_segments_itself(sce
         a, b = getattr(here.points, name), getattr(dealt.points, name)
         scale = comm.allreduce(float(np.max(np.abs(a), initial=0.0)), op=MPI.MAX)
         assert np.allclose(a, b, rtol=0, atol=1e-14 * scale), name
+
+
+@pytest.mark.parametrize("counts", [[7], [0, 0], [10, 0], [0, 9, 1], [5, 5, 5],
+                                    [30, 1, 0, 2, 13], [1, 2, 3, 4, 5, 6, 7, 100]])
+def test_dealing_keeps_each_ranks_own_items_up_to_its_share(counts):
+    """Equal shares (differing by one at most), every item dealt once, and a
+    rank keeps as many of its own as its share holds: only the rest travel
+    (dealing by position in rank order sent a busy rank's own items away and
+    brought it others')."""
+    owners = [dealt_items(counts, rank) for rank in range(len(counts))]
+    taken = np.bincount(np.concatenate(owners), minlength=len(counts))
+    assert taken.sum() == sum(counts) and taken.max() - taken.min() <= 1
+    for rank, mine in enumerate(owners):
+        assert len(mine) == counts[rank]
+        assert np.sum(mine == rank) == min(counts[rank], taken[rank])
+        # a rank sends only where it keeps its whole share, and receives only where it sends none
+        assert np.all(mine == rank) or taken[rank] == np.sum(mine == rank)
 
 
 def test_blocks_apart_deal_out_no_pair_and_no_candidate():
