@@ -8,9 +8,11 @@ given as the list of their four faces' tags: nobody says which face is slave or 
 the pairs between the blocks are found by the search (docs/SELF_CONTACT.md). Every interface
 carries the uniform pressure q, to round-off (a patch test); with
 ``--configuration current`` the pressure on the deformed faces, q/(1 + ν(1 + ν)q/E) (the
-blocks widen). Run:
-``python3 demos/stack_one_term.py [--kind K] [--configuration C] [--steps N] [--json F]``
-(or with ``mpirun -n 2``).
+blocks widen). ``--mu M --shear S``: Coulomb friction μ = M on the interfaces and a
+tangential traction S·q on the top face, which the interfaces pass down in stick and slip
+(the ground stays frictionless; the left edges hold the blocks). Run:
+``python3 demos/stack_one_term.py [--kind K] [--configuration C] [--steps N] [--mu M]
+[--shear S] [--json F]`` (or with ``mpirun -n 2``).
 """
 import argparse
 import json
@@ -20,7 +22,8 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidPlane
+from dolfinx_mortar import (ContactTerm, CoulombFriction, LoadPathSolver, NonlinearContactProblem,
+                            RigidPlane)
 from demo_support.stack import stacked_blocks
 from dolfinx_mortar.small_strain.elastic import linear_elastic_residual
 
@@ -38,6 +41,10 @@ def main(argv=None) -> dict:
     parser.add_argument("--configuration", default="initial",
                         help="basis_configuration of both terms (initial)")
     parser.add_argument("--steps", type=int, default=1, help="load steps (1)")
+    parser.add_argument("--mu", type=float, default=0.0,
+                        help="Coulomb friction on the interfaces (0: frictionless)")
+    parser.add_argument("--shear", type=float, default=0.0,
+                        help="tangential traction on the top face, a fraction of q (0)")
     parser.add_argument("--json", help="write the figures to this file")
     args = parser.parse_args(argv)
     comm = MPI.COMM_WORLD
@@ -47,7 +54,8 @@ def main(argv=None) -> dict:
     E = 1.0
     ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
     load = fem.Constant(mesh, 0.0)     # q at the end of the load path
-    F = linear_elastic_residual(u, E, 0.3) + load * v[1] * ds(TOP[2])
+    F = (linear_elastic_residual(u, E, 0.3) + load * v[1] * ds(TOP[2])
+         - args.shear * load * v[0] * ds(TOP[2]))
     left = fem.locate_dofs_topological(V.sub(0), 1, facet_tags.find(LEFT))
     bcs = [fem.dirichletbc(0.0, left, V.sub(0))]
     penalty = 1e3 * E / 0.03
@@ -55,8 +63,9 @@ def main(argv=None) -> dict:
                "basis_configuration": args.configuration}
     ground = ContactTerm(u, facet_tags, BOTTOM[0], obstacle=RigidPlane([0, 0], [0, 1]),
                          name="ground", **options)
+    friction = CoulombFriction(args.mu) if args.mu > 0 else None
     interfaces = ContactTerm(u, facet_tags, [TOP[0], BOTTOM[1], TOP[1], BOTTOM[2]],
-                             self_contact=True, name="blocks", **options)
+                             self_contact=True, name="blocks", friction=friction, **options)
     problem = NonlinearContactProblem(F, u, [ground, interfaces], bcs)
 
     def ramp(t: float) -> None:
@@ -73,6 +82,14 @@ def main(argv=None) -> dict:
         "interface_nodes": int(on_faces.sum()),
         "internal_force": float(np.linalg.norm(interfaces.results.contact_force())),
     }
+    if friction is not None:
+        # the tangential traction against the Coulomb cone, node by node
+        traction = interfaces.results.surface_friction(gather=True)
+        same = np.argsort(traction.global_index)[np.argsort(np.argsort(pressures.global_index))]
+        q_t, state = np.abs(traction.q[same, 0])[on_faces], traction.stick_slip[same][on_faces]
+        figures["friction_over_cone_max"] = float(np.max(q_t / (args.mu * pressures.p[on_faces])))
+        figures["slip_nodes"] = int(np.sum(state == 2))
+        figures["stick_nodes"] = int(np.sum(state == 1))
     if comm.rank == 0:
         print(f"{figures['newton_iterations']} Newton iterations; ground force "
               f"{figures['ground_force']:.10g} for the load {q}; pressure on the "

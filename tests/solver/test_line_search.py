@@ -13,7 +13,8 @@ from demo_support.laws import neo_hookean_residual
 from support import load_demo
 from support.meshes import rectangle
 
-from dolfinx_mortar import ContactTerm, LoadPathSolver, NonlinearContactProblem, RigidSphere
+from dolfinx_mortar import (ContactTerm, CoulombFriction, LoadPathSolver, NonlinearContactProblem,
+                            RigidSphere)
 from dolfinx_mortar.solver.newton import EquilibriumTest
 from dolfinx_mortar.solver.newton.line_search import FullStepFirst, l2_step_length
 
@@ -233,7 +234,7 @@ class CountingContactTerm(ContactTerm):
         return super().update(bcs)
 
 
-def pressed_block(configuration: str = "current"):
+def pressed_block(configuration: str = "current", friction=None):
     """A neo-Hookean block pressed by its top face onto a rigid disk."""
     domain, tags = rectangle(MPI.COMM_WORLD, 0.0, 0.5, (12, 6), bottom=BOTTOM, top=TOP,
                              left=LEFT)
@@ -242,7 +243,7 @@ def pressed_block(configuration: str = "current"):
     F = neo_hookean_residual(u, 1.0, 0.3)
     contact = CountingContactTerm(u, tags, BOTTOM, obstacle=RigidSphere([0.5, -2.0], 2.0),
                                   kind="LcLS*", penalty=200.0,
-                                  basis_configuration=configuration)
+                                  basis_configuration=configuration, friction=friction)
     push = fem.Constant(domain, PETSc.ScalarType(0.0))
     left = fem.locate_dofs_topological(V.sub(0), 1, tags.find(LEFT))
     top = fem.locate_dofs_topological(V.sub(1), 1, tags.find(TOP))
@@ -339,17 +340,21 @@ def test_a_neo_hookean_block_pressed_and_slid_takes_the_requested_steps(configur
 
 
 @pytest.mark.parametrize("configuration", ["previous", "current"])
-def test_a_linear_bulk_keeps_full_frozen_steps_and_a_nonlinear_one_shortens_them(
+def test_a_linear_bulk_keeps_full_frozen_steps_and_a_nonlinear_or_rubbing_one_shortens_them(
         configuration):
-    """Frozen phases shorten steps for a nonlinear bulk only; the current
-    surface's phase always does (a linear bulk's Hertz 3D on two bodies
+    """Frozen phases shorten steps for a nonlinear bulk or friction only; the
+    current surface's phase always does (a linear bulk's Hertz 3D on two bodies
     diverged to 1e134 in it with full steps)."""
     problem, contact, _ = pressed_block(configuration)
     V = problem.u.function_space
     u, v = problem.u, ufl.TestFunction(V)
     linear = NonlinearContactProblem(ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx, u,
                                      contact, problem.bcs)
-    for bulk, frozen_shortens in ((problem, True), (linear, False)):
+    rubbing, rubbing_contact, _ = pressed_block(configuration, CoulombFriction(0.3))
+    u, v = rubbing.u, ufl.TestFunction(rubbing.u.function_space)
+    frictional = NonlinearContactProblem(ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx, u,
+                                         rubbing_contact, rubbing.bcs)
+    for bulk, frozen_shortens in ((problem, True), (linear, False), (frictional, True)):
         solver = LoadPathSolver(bulk)
         with solver.options():
             snes = solver.create_snes()

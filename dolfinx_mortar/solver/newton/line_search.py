@@ -162,7 +162,7 @@ class FullStepFirst:
     def frozen_phase(self) -> Iterator[None]:
         """Inside the ``with`` block, the rule of a phase on frozen surfaces:
         full steps unless their residual is not finite, except where
-        :attr:`shortens_frozen_steps` (a bulk law nonlinear in u).
+        :attr:`shortens_frozen_steps` (a bulk law nonlinear in u, or friction).
 
         A frozen surface is the piecewise-linear "previous" model. With a
         linear bulk, shortened steps only slowed the active set down (Newton
@@ -170,7 +170,11 @@ class FullStepFirst:
         with an elastic block 23/33, Hertz 3D 16/24); a neo-Hookean bulk
         needs them (a disk pressed into a block and slid sideways, 12 steps
         requested: 12 steps and no cut-back against 24 steps and 7
-        cut-backs; ironing 2D 800 against 1387 Newton iterations).
+        cut-backs; ironing 2D 800 against 1387 Newton iterations). So does
+        friction, as on frozen surfaces elsewhere: with full steps the frozen
+        phase of LmLS* on a stack of blocks sheared in self-contact cycled at
+        half the step's force, and the slip limit at tan α = 0.5, μ = 0.1
+        with LcLS* stalled at every cut-back (docs/FRICTION.md).
         """
         if self.shortens_frozen_steps:
             yield
@@ -280,12 +284,14 @@ def library_line_search(problem: Residual, traits: Sequence["NewtonTraits"],
     ``traits`` (:class:`~dolfinx_mortar.contact.newton.NewtonTraits`).
 
     It shortens steps on the current surface, and on frozen surfaces
-    (``"initial"``, ``"previous"``) for a bulk law nonlinear in u
-    (``bulk_is_linear`` False: the user's Jacobian form contains u) or with
-    friction; in the frozen phase of a ``"current"`` step only for a
-    nonlinear bulk (:meth:`FullStepFirst.frozen_phase`). Friction needs it: a
+    (``"initial"``, ``"previous"``, and the frozen phase of a ``"current"``
+    step) for a bulk law nonlinear in u (``bulk_is_linear`` False: the
+    user's Jacobian form contains u) or with friction
+    (:meth:`FullStepFirst.frozen_phase`). Friction needs it: a
     slipping node at the contact edge whose direction turns had full steps
     throw it from side to side (two pressed cylinders, Newton cycling at 2e-3
     of the force)."""
-    shorten = any(t.follows_u or t.frictional for t in traits) or not bulk_is_linear
-    return FullStepFirst(problem, shorten=shorten, shortens_frozen_steps=not bulk_is_linear)
+    frictional = any(t.frictional for t in traits)
+    shorten = any(t.follows_u for t in traits) or frictional or not bulk_is_linear
+    return FullStepFirst(problem, shorten=shorten,
+                         shortens_frozen_steps=frictional or not bulk_is_linear)
