@@ -81,6 +81,9 @@ def main(argv=None) -> dict:
         "interface_pressure_max": float(pressures.p[on_faces].max()),
         "interface_nodes": int(on_faces.sum()),
         "internal_force": float(np.linalg.norm(interfaces.results.contact_force())),
+        # what each face receives from the block it touches: ±q up/down
+        "face_forces": {str(tag): interfaces.results.contact_force(tag=tag).tolist()
+                        for tag in (TOP[0], BOTTOM[1], TOP[1], BOTTOM[2])},
     }
     if friction is not None:
         # the tangential traction against the Coulomb cone, node by node
@@ -90,6 +93,9 @@ def main(argv=None) -> dict:
         figures["friction_over_cone_max"] = float(np.max(q_t / (args.mu * pressures.p[on_faces])))
         figures["slip_nodes"] = int(np.sum(state == 2))
         figures["stick_nodes"] = int(np.sum(state == 1))
+        figures["face_friction_forces"] = {
+            str(tag): interfaces.results.tangential_force(tag=tag).tolist()
+            for tag in (TOP[0], BOTTOM[1], TOP[1], BOTTOM[2])}
     if comm.rank == 0:
         print(f"{figures['newton_iterations']} Newton iterations; ground force "
               f"{figures['ground_force']:.10g} for the load {q}; pressure on the "

@@ -121,6 +121,10 @@ def facet_surface(space: Union[fem.FunctionSpace, dolfinx.mesh.Mesh],
                               axisymmetric=axisymmetric)
     # each facet's volume cell: a self-contact surface never pairs facets whose cells touch
     surface.volume_nodes = cell_dofs[cell_of_facet].astype(np.int64)
+    # which of the tags each facet carries (the results of a term over several tags)
+    surface.cell_tags = np.zeros(len(facets), dtype=np.int32)
+    for t in tags:
+        surface.cell_tags[np.isin(facets, facet_tags.find(t))] = t
     if len(cells) == 0:
         return surface
     # Outward: the facet normal must point away from its cell's centroid.

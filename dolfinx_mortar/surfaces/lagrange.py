@@ -184,6 +184,9 @@ class LagrangeSurface:
     #: the nodes of each facet's cell of the volume mesh (local, as ``cells``), where the
     #: surface was taken from one (:func:`~dolfinx_mortar.surfaces.facet_surface.facet_surface`)
     volume_nodes: Optional[npt.NDArray[np.int64]] = None
+    #: each cell's facet tag, where the surface was taken from tagged facets
+    #: (:func:`~dolfinx_mortar.surfaces.facet_surface.facet_surface`)
+    cell_tags: Optional[npt.NDArray[np.int32]] = None
 
     def __init__(self, cell: str, degree: int, x: npt.ArrayLike, cells: npt.ArrayLike,
                  layout: Optional[NodeLayout] = None, serendipity: bool = False,
@@ -327,6 +330,7 @@ class LagrangeSurface:
                                quadratic_transform=self.reference.transform is not None,
                                check_cells=check_cells, axisymmetric=self.axisymmetric)
         like.volume_nodes = self.volume_nodes
+        like.cell_tags = self.cell_tags
         return like
 
     @property

@@ -79,7 +79,8 @@ def test_a_wall_thinner_than_the_search_radius_is_named():
 def test_a_stack_of_three_merged_bodies_under_one_term_carries_the_pressure():
     """The three blocks on a rigid plane, pressed by q on the top: the four faces
     of the two interfaces in one self-contact term carry q at every node to
-    round-off, and the ground the whole load (a patch test)."""
+    round-off, and the ground the whole load (a patch test); each face's own
+    resultant (``contact_force(tag=...)``) is q."""
     comm, q = MPI.COMM_WORLD, 0.01
     domain, facet_tags, _ = three_blocks(comm)
     V = fem.functionspace(domain, ("Lagrange", 1, (2,)))
@@ -101,3 +102,9 @@ def test_a_stack_of_three_merged_bodies_under_one_term_carries_the_pressure():
     assert on_faces.sum() == 9 + 10 + 10 + 11
     assert np.allclose(pressure.p[on_faces], q, rtol=1e-9, atol=0)
     assert ground.results.contact_force()[1] == pytest.approx(q, rel=1e-12)
+    # each body's face: pushed up by q from below, down by q from above
+    for tag, sign in zip(faces, (-1, 1, -1, 1)):
+        fx, fy = interfaces.results.contact_force(tag=tag)
+        assert fy == pytest.approx(sign * q, rel=1e-12) and abs(fx) < 1e-12 * q
+    with pytest.raises(ValueError, match=f"tag {LEFT} is not one of the term's slave facet tags"):
+        interfaces.results.contact_force(tag=LEFT)

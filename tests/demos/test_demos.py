@@ -143,7 +143,8 @@ def test_a_stack_under_one_term_with_friction_on_the_current_surface():
     (full steps, |R| at half the step's force after 40 iterations, at every
     cut-back) until that phase shortened its steps with friction, as frozen
     surfaces do elsewhere (``line_search.library_line_search``)."""
-    figures = {configuration: load_demo("stack_one_term").main(
+    demo = load_demo("stack_one_term")
+    figures = {configuration: demo.main(
         ["--kind", "LmLS*", "--configuration", configuration, "--steps", "2", "--mu", "0.5",
          "--shear", "-0.3"]) for configuration in ("previous", "current")}
     current, previous = figures["current"], figures["previous"]
@@ -151,6 +152,16 @@ def test_a_stack_under_one_term_with_friction_on_the_current_surface():
     assert current["ground_force"] == pytest.approx(q, rel=1e-12)
     assert current["internal_force"] < 1e-12 * q
     assert current["friction_over_cone_max"] <= 1 + 1e-6
+    # the upper block's bottom face carries its load, whatever the friction does
+    top, bottom = demo.TOP, demo.BOTTOM
+    for tag, sign in ((top[0], -1), (bottom[1], 1), (top[1], -1), (bottom[2], 1)):
+        assert current["face_forces"][str(tag)][1] == pytest.approx(sign * q, rel=1e-10)
+    # the friction the two faces of an interface exchange: equal and opposite, and
+    # carried (measured 0.03 q and 0.10 q)
+    friction = {int(tag): np.array(f) for tag, f in current["face_friction_forces"].items()}
+    for lower, upper in ((top[0], bottom[1]), (top[1], bottom[2])):
+        assert np.linalg.norm(friction[lower] + friction[upper]) < 1e-12 * q
+        assert abs(friction[upper][0]) > 0.01 * q
     for name in ("slip_nodes", "stick_nodes", "interface_nodes"):
         assert current[name] == previous[name]
     # measured 2.8e-4 at the most pressed node and 1.3% at the least (the right
@@ -167,13 +178,20 @@ def test_a_stack_under_one_term_carries_the_pressure_at_every_interface():
     (a list of four face tags, no slave or master named), uniform pressure: every
     node of the four faces carries q to round-off, the ground the whole load, and
     the term's forces cancel inside the stack (a patch test; docs/SELF_CONTACT.md)."""
-    figures = load_demo("stack_one_term").main([])
+    demo = load_demo("stack_one_term")
+    figures = demo.main([])
     q = figures["load"]
     assert figures["interface_nodes"] > 0
     assert figures["interface_pressure_min"] == pytest.approx(q, rel=1e-9)
     assert figures["interface_pressure_max"] == pytest.approx(q, rel=1e-9)
     assert figures["ground_force"] == pytest.approx(q, rel=1e-12)
     assert figures["internal_force"] < 1e-12 * q
+    # each face's share of the term's forces: a block's bottom face is pushed up by q,
+    # a top face down (contact_force(tag=...))
+    top, bottom = demo.TOP, demo.BOTTOM
+    for tag, sign in ((top[0], -1), (bottom[1], 1), (top[1], -1), (bottom[2], 1)):
+        fx, fy = figures["face_forces"][str(tag)]
+        assert fy == pytest.approx(sign * q, rel=1e-12) and abs(fx) < 1e-12 * q
 
 
 def test_a_tube_squeezed_until_its_inner_faces_meet(out):

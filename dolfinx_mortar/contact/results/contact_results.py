@@ -109,10 +109,23 @@ class ContactResults:
         p = self.nodal_pressures(state)
         return float(self.term.comm.allreduce(float(np.sum((state.lumped_weights * p)[:n]))))
 
-    def contact_force(self, state: Optional[ContactState] = None) -> FloatArray:
+    def contact_force(self, state: Optional[ContactState] = None,
+                      tag: Optional[int] = None) -> FloatArray:
         """The resultant of the contact traction on the slave body, a gdim-vector:
-        ``−Σ R_c`` over the slave nodes' dofs, summed over all ranks."""
-        return slave_resultant(self.term, (state or self.term.evaluate()).residual)
+        ``−Σ R_c`` over the slave nodes' dofs, summed over all ranks (collective).
+
+        Parameters
+        ----------
+        state
+            A contact state; by default the one at the present u.
+        tag
+            One of the term's slave facet tags: the resultant on the nodes of
+            those facets only (a node on facets of two tags counts in both).
+            Over a self-contact surface, or several bodies under one term, the
+            whole resultant is 0 (the forces are internal); per tag it is the
+            force one body's face receives from the others.
+        """
+        return slave_resultant(self.term, (state or self.term.evaluate()).residual, tag)
 
     def active_nodes(self, state: Optional[ContactState] = None) -> int:
         """The number of slave nodes with a positive pressure, over all ranks."""
@@ -135,9 +148,10 @@ class ContactResults:
         (:meth:`.FrictionResults.surface_friction`). Collective."""
         return self._friction.surface_friction(state, gather)
 
-    def tangential_force(self, state: Optional[ContactState] = None) -> FloatArray:
+    def tangential_force(self, state: Optional[ContactState] = None,
+                         tag: Optional[int] = None) -> FloatArray:
         """The resultant of the friction traction (:meth:`.FrictionResults.tangential_force`)."""
-        return self._friction.tangential_force(state)
+        return self._friction.tangential_force(state, tag)
 
     def dissipation(self) -> float:
         """The frictional dissipation so far (:meth:`.FrictionResults.dissipation`)."""

@@ -106,13 +106,14 @@ class FrictionResults:
             self.term, gather, self.tangential_tractions(state), self.slip_states(state))
         return SurfaceFriction(x, q, stick_slip, index)
 
-    def tangential_force(self, state: Optional[ContactState] = None) -> FloatArray:
+    def tangential_force(self, state: Optional[ContactState] = None,
+                         tag: Optional[int] = None) -> FloatArray:
         """The resultant of the tangential (friction) traction on the slave
         body, a gdim-vector over all ranks: ``−Σ G_Tᵀ f_T`` over the slave
-        nodes' dofs, as
+        nodes' dofs (``tag``: of one of the term's slave tags only), as
         :meth:`~dolfinx_mortar.contact.results.contact_results.ContactResults.contact_force`
         is of the whole traction."""
-        return slave_resultant(self.term, self._friction(state).residual)
+        return slave_resultant(self.term, self._friction(state).residual, tag)
 
     def dissipation(self) -> float:
         """The frictional dissipation ``Σ_steps Σ_A f_T,A · Δy_p,A`` over the

@@ -3,6 +3,8 @@ surface's nodes with the nodes' coordinates (per rank or gathered), and the
 resultant of a residual on the slave body."""
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
@@ -48,8 +50,9 @@ def at_surface_nodes(term, gather: bool, *values: np.ndarray) -> tuple:
     return (x[order], *gathered, np.concatenate([q[2] for q in parts])[order])
 
 
-def slave_resultant(term, residual: PETSc.Vec) -> FloatArray:
-    """``−Σ residual`` over the slave nodes' owned dofs, summed over all ranks.
+def slave_resultant(term, residual: PETSc.Vec, tag: Optional[int] = None) -> FloatArray:
+    """``−Σ residual`` over the slave nodes' owned dofs, summed over all ranks
+    (``tag``: over the nodes of the slave facets with that tag only).
 
     Parameters
     ----------
@@ -57,14 +60,22 @@ def slave_resultant(term, residual: PETSc.Vec) -> FloatArray:
         The :class:`~dolfinx_mortar.contact.term.ContactTerm` reporting.
     residual
         A residual in the displacement space (blocked by gdim).
+    tag
+        One of the term's slave facet tags, or None (the whole slave surface).
 
     Returns
     -------
     FloatArray
         A gdim-vector, the same on every rank.
     """
-    gdim = term.slave.gdim
+    gdim, slave = term.slave.gdim, term.slave
     R = residual.array_r.reshape(-1, gdim)
-    nodes = term.slave.owned_nodes
+    if tag is None:
+        nodes = slave.owned_nodes
+    else:
+        tags = (term.slave_tag,) if np.ndim(term.slave_tag) == 0 else term.slave_tag
+        if tag not in tags:
+            raise ValueError(f"tag {tag!r} is not one of the term's slave facet tags {tags}")
+        nodes = slave.layout.owned_on_cells(slave.cells[slave.cell_tags == tag])
     local = -R[nodes].sum(axis=0) if len(nodes) else np.zeros(gdim)
     return np.asarray(term.comm.allreduce(local))
