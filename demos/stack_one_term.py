@@ -87,9 +87,9 @@ def main(argv=None) -> dict:
     }
     if friction is not None:
         # the tangential traction against the Coulomb cone, node by node
+        # gathered in the same order as the pressures (both by the nodes' coordinates)
         traction = interfaces.results.surface_friction(gather=True)
-        same = np.argsort(traction.global_index)[np.argsort(np.argsort(pressures.global_index))]
-        q_t, state = np.abs(traction.q[same, 0])[on_faces], traction.stick_slip[same][on_faces]
+        q_t, state = np.abs(traction.q[on_faces, 0]), traction.stick_slip[on_faces]
         figures["friction_over_cone_max"] = float(np.max(q_t / (args.mu * pressures.p[on_faces])))
         figures["slip_nodes"] = int(np.sum(state == 2))
         figures["stick_nodes"] = int(np.sum(state == 1))

@@ -6,12 +6,13 @@ to 100–200 (Hessians) times a pair's values, and the pairs sit where the
 surfaces press, often on one rank. So each rank keeps the search and the values
 of its own slave facets' pairs, and their Jet work is dealt out in equal shares
 (a rank keeps what its share holds of its own pairs, the rest go to ranks short
-of theirs: :func:`dealt_items`), each pair with what the kernel reads for it — the pair's slave cell, the slave cells
-around its nodes and around the other nodes of their normal clusters (the
-averaged normals and their derivatives), and the pair's master cell. A rank
-receives its share of the work and the facets of that share, not both whole
-surfaces (until 2026-11 every rank gathered both at every evaluation: 28.6 MB
-per rank at 16 ranks on the ironing scene).
+of theirs: :func:`dealt_items`), each pair with what the kernel reads for it —
+the pair's slave cell, the slave cells around its nodes and around the other
+nodes of their normal clusters (the averaged normals and their derivatives),
+and the pair's master cell. A rank receives its share of the work and the
+facets of that share, not both whole surfaces (until 2026-11 every rank
+gathered both at every evaluation: 28.6 MB per rank at 16 ranks on the ironing
+scene).
 
 MPI's ``alltoall`` does the exchange: what travels is a few cells per pair,
 chosen by global node ids, which DOLFINx's scatterers (built for a fixed ghost
@@ -104,8 +105,8 @@ def own_pairs(coupling: FoundPairs, which: Optional[npt.NDArray[np.bool_]] = Non
 def deal_evenly(coupling: FoundPairs, which: npt.NDArray[np.bool_],
                 *values: npt.NDArray) -> DealtPairs:
     """All ranks' pairs where ``which`` is True, dealt out in equal shares (each
-    rank keeps what its share holds of its own: :func:`dealt_items`) with the facets they read and ``values`` (one row per
-    kept pair). Collective."""
+    rank keeps what its share holds of its own: :func:`dealt_items`) with the
+    facets they read and ``values`` (one row per kept pair). Collective."""
     comm: MPI.Comm = coupling.slave.layout.comm
     mine = own_pairs(coupling, which, *values)
     if comm.size == 1:

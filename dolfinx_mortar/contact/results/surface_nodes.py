@@ -68,7 +68,8 @@ def slave_resultant(term, residual: PETSc.Vec, tag: Optional[int] = None) -> Flo
     FloatArray
         A gdim-vector, the same on every rank.
     """
-    gdim, slave = term.slave.gdim, term.slave
+    slave = term.slave
+    gdim = slave.gdim
     R = residual.array_r.reshape(-1, gdim)
     if tag is None:
         nodes = slave.owned_nodes
