@@ -38,7 +38,7 @@ from dolfinx_mortar.layout import NodeLayout, assemble_blocks
 from dolfinx_mortar.mortar.coupling import MortarCoupling
 from dolfinx_mortar.contact.obstacles import RigidObstacle, relative_to
 from dolfinx_mortar.contact.gap_sources.pointwise import point_gaps_of
-from dolfinx_mortar.contact.gap_sources.slip import (SlipOperator, StepStart,
+from dolfinx_mortar.contact.gap_sources.slip import (SlipOperator, StepStart, dual_slip_blocks,
                                                      mortar_slip_operator, obstacle_slip_operator)
 from dolfinx_mortar.kinds import DUAL_KINDS, is_global
 from dolfinx_mortar.surfaces.facet_surface import nodal_displacement
@@ -87,8 +87,9 @@ class GapSourceBase:
         #: M̄ = N_std C_std on each slave cell (N_std: the displacement's basis)
         self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
         self._stiffness_product = TransposeProduct()
-        #: LmLS, LmLS*: the slip of a node from its own displacement (see
-        #: :func:`~dolfinx_mortar.contact.gap_sources.slip.lumped_slave_part`)
+        #: LmLS, LmLS*: against an obstacle the slip of a node from its own
+        #: displacement (:func:`~dolfinx_mortar.contact.gap_sources.slip.lumped_slave_part`);
+        #: against an elastic master in the dual basis (:meth:`MortarGap.slip_pair_operators`)
         self.lumped_slip = law.gap_kind not in DUAL_KINDS and not is_global(law.gap_kind)
 
     @property
@@ -340,14 +341,25 @@ class MortarGap(GapSourceBase):
                                  blocks.reshape(npairs, ns, width))
         #: the pairs' slave cells, their columns (slave then master dofs) and
         #: the scalar couplings ``[D̄ | −M̄]`` (pairs, ns, ns + nm): friction's slip
+        #: (:meth:`slip_pair_operators`)
         self.pair_operators = (slave_cells, cols, np.concatenate([Dg, -Mg], axis=2))
         #: the active set's positive gaps (the pointwise set's segment points)
         self.points = point_gaps_of(self)
 
+    def slip_pair_operators(self, project: bool) -> tuple:
+        """:attr:`pair_operators` in the basis friction measures the slip in: the
+        kind's own (and unprojected, for GLS), or for LmLS and LmLS* the dual
+        basis of the same ``∫ M̄_A`` (:func:`~dolfinx_mortar.contact.gap_sources.slip.dual_slip_blocks`
+        says why)."""
+        if self.lumped_slip and project:
+            return dual_slip_blocks(self)
+        return self.pair_operators
+
     def slip_operator(self, start: StepStart, project: bool = True) -> SlipOperator:
-        """Friction's slip operator (``[D̄ | −M̄]`` and the segmentation's
-        normals, frozen with the bases; ``project`` False: unprojected, for GLS)."""
-        return mortar_slip_operator(self, self.lumped_slip, project)
+        """Friction's slip operator (``[D̄ | −M̄]`` of :meth:`slip_pair_operators`
+        and the segmentation's normals, frozen with the bases; ``project``
+        False: unprojected, for GLS)."""
+        return mortar_slip_operator(self, project)
 
     def evaluate(self, u, mask: Optional[PETSc.Vec]) -> ContactState:
         """The contact state at the displacement Function ``u``."""

@@ -18,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
+from dolfinx_mortar.kinds import BasisKind, is_partition_of_unity
 from dolfinx_mortar.layout import MassMatrixSolver, NodeLayout, assemble_blocks
 
 FloatArray = npt.NDArray[np.float64]
@@ -68,27 +69,54 @@ def stacked_identities(projectors: FloatArray) -> FloatArray:
 
 
 def lumped_slave_part(blocks: FloatArray, slave_nodes: int) -> FloatArray:
-    """The scalar slip couplings ``[D̄ | −M̄]`` (cells, rows, columns) with the
-    slave part ``D̄`` lumped onto its diagonal (row sums ``∫ M̄_A`` kept).
+    """The scalar slip couplings against a rigid obstacle (cells, rows,
+    columns) lumped onto their diagonal (row sums ``∫ M̄_A`` kept): LmLS and
+    LmLS* measure a node's slip from its own displacement there.
 
-    For LmLS and LmLS* ``D̄_AB = ∫ M̄_A N_B`` couples each node to its
-    neighbours (a row-scaled consistent mass, 1/6 : 2/3 : 1/6 on a uniform
-    line), and with it the nodal Coulomb conditions are set on an average of
-    the neighbours' slips. Newton's stick/slip iteration then ran away: on a
-    block pushed sideways at 0.2 of its load (μ = 0.3, ε = 1e3 E/h) the slip
-    of the slipping zone reversed from one iteration to the next, hundreds of
-    stick bands deep, and it stalled at every increment (a first step from
-    rest is the same problem at any load). The dual kinds' D̄ is diagonal
-    already (biorthogonality) and they converged in 4–5 iterations; lumped,
-    LmLS(*) converge in the same (docs/FRICTION.md). The row sums keep the
-    slip objective for rigid translations, and the master part stays the
-    mortar integral.
+    Their ``D̄_AB = ∫ M̄_A N_B`` couples each node to its neighbours (a
+    row-scaled consistent mass), and with it the nodal Coulomb conditions are
+    set on an average of the neighbours' slips, which made Newton's stick/slip
+    iteration run away (:func:`dual_slip_blocks`).
+    The obstacle's part ``−(∫ M̄_A) Δc`` is a rigid motion, so the lumped slip
+    is still none for every motion the two sides share. Against an elastic
+    master the dual basis measures the slip instead.
     """
     slave, master = blocks[:, :, :slave_nodes], blocks[:, :, slave_nodes:]
     diagonal = np.zeros_like(slave)
     rows = np.arange(slave.shape[1])
     diagonal[:, rows, rows] = slave.sum(axis=2)
     return np.concatenate([diagonal, master], axis=2)
+
+
+def dual_slip_blocks(source) -> tuple:
+    """LmLS, LmLS* against an elastic master: ``source.pair_operators`` with the
+    scalar couplings ``[D̄ | −M̄]`` of the dual basis of the same ``∫ M̄_A``
+    (LcLS* for LmLS*, LcLS for LmLS).
+
+    Their own ``D̄_AB = ∫ M̄_A N_B`` is a row-scaled consistent mass, and the
+    nodal Coulomb conditions on such averages of the neighbours' slips made
+    Newton's stick/slip iteration run away (a block pushed sideways at 0.2 of
+    its load, μ = 0.3: the slipping zone's slip reversed from one iteration
+    to the next and every increment stalled). Lumping ``D̄`` onto the
+    diagonal beside the mortar ``M̄`` (until 2026-12-08) converged, but read a
+    motion both sides share as slip wherever it was not uniform, ``(W − D̄)u``:
+    two blocks widening alike under a uniform pressure put the node at their
+    held edge on the Coulomb cone and moved the pressure by 3.7%. Taking the
+    master at the node's projection instead is no slip for shared motions,
+    but does not pass a uniform traction on to a non-matching master. The
+    dual basis does both (biorthogonality: ``D̄`` diagonal where a facet is
+    covered), as for the dual kinds themselves (docs/FRICTION.md, §The slip of
+    LmLS and LmLS*).
+    """
+    coupling = source.coupling
+    dual = BasisKind.LcLS_star if is_partition_of_unity(source.basis.kind) else BasisKind.LcLS
+    C = coupling.basis(dual).coefficients
+    T = source.slave.reference.transform
+    C = (C if T is None else np.einsum("ab,cbd->cad", T, C))[coupling.pairs[:, 0]]
+    Dn, Mn, _ = coupling.raw_pairs
+    cells, cols, _ = source.pair_operators
+    return cells, cols, np.concatenate([np.einsum("pba,pbc->pac", C, Dn),
+                                        -np.einsum("pba,pbc->pac", C, Mn)], axis=2)
 
 
 def assemble_slip(dofs: NodeLayout, gdim: int, cells: npt.NDArray[np.int32],
@@ -101,12 +129,10 @@ def assemble_slip(dofs: NodeLayout, gdim: int, cells: npt.NDArray[np.int32],
     return assemble_blocks(dofs, rows, dofs, cols, values.reshape(nc, nr * gdim, cols.shape[1]))
 
 
-def mortar_slip_operator(source, lumped: bool, project: bool) -> SlipOperator:
+def mortar_slip_operator(source, project: bool) -> SlipOperator:
     """The slip operator of a source frozen against an elastic master (its
     pair operators ``[D̄ | −M̄]`` and the segmentation's nodal normals)."""
-    cells, cols, blocks = source.pair_operators
-    if lumped and project:
-        blocks = lumped_slave_part(blocks, cells.shape[1])
+    cells, cols, blocks = source.slip_pair_operators(project)
     projectors = tangent_projectors(source.coupling.normals)
     applied = projectors if project else stacked_identities(projectors)
     G_T = assemble_slip(source.dofs, source.slave.gdim, cells, cols, blocks, applied)
