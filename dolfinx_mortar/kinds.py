@@ -73,6 +73,11 @@ def unstarred_partner(kind: KindLike) -> BasisKind:
     return _kernels.unstarred_partner(parse_kind(kind))
 
 
+def dual_partner(kind: KindLike) -> BasisKind:
+    """The dual kind with the same ∫M_A: LcLS* for LmLS* (W_A), LcLS for LmLS (1)."""
+    return BasisKind.LcLS_star if is_partition_of_unity(kind) else BasisKind.LcLS
+
+
 def kind_name(kind: KindLike) -> str:
     """Canonical name of a kind or alias (``"dual"`` → ``"LcLS*"``)."""
     return _kernels.to_string(parse_kind(kind))

@@ -120,6 +120,10 @@ class ReferenceLagrange:
         mids = np.array([vertices[e].mean(axis=0) for e in edges])
         return np.vstack([vertices, mids])
 
+    def standard_coefficients(self, C: FloatArray) -> FloatArray:
+        """Per-cell coefficients (cells, nd, nd) in the standard basis: ``T C`` (or ``C``)."""
+        return C if self.transform is None else np.einsum("ab,cbd->cad", self.transform, C)
+
     def _quadratic_transform(self) -> FloatArray:
         if self.degree != 2:
             raise ValueError("the transformed quadratic basis applies to quadratic facets only")

@@ -82,10 +82,8 @@ class GapSourceBase:
         #: ω_A of Π_c = Σ (ω_A/2)⟨d̄_A⟩²
         self.weights = law.weights(self.basis.lumped_weights)
         self.dofs = dof_layout(slave.layout, slave.gdim)
-        T = slave.reference.transform
-        C = self.basis.coefficients
         #: M̄ = N_std C_std on each slave cell (N_std: the displacement's basis)
-        self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
+        self.coefficients_std = slave.reference.standard_coefficients(self.basis.coefficients)
         self._stiffness_product = TransposeProduct()
         #: LmLS, LmLS*: against an obstacle the slip of a node from its own
         #: displacement (:func:`~dolfinx_mortar.contact.gap_sources.slip.lumped_slave_part`);
@@ -311,9 +309,8 @@ class MortarGap(GapSourceBase):
         if boundary_modification:
             # dual basis rebuilt over the covered part of every covered cell
             # (Popp et al. 2013); its ∫_cov M̄_A = 1 pairs it with W_cov
-            C = coupling.covered_coefficients(self.basis.kind)
-            T = self.slave.reference.transform
-            self.coefficients_std = C if T is None else np.einsum("ab,cbd->cad", T, C)
+            self.coefficients_std = self.slave.reference.standard_coefficients(
+                coupling.covered_coefficients(self.basis.kind))
             _, _, W_cov = coupling.covered_element_mass()
             self._weights_source = W_cov
             self.weights = law.weights(W_cov)

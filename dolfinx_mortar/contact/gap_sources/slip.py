@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 from petsc4py import PETSc
 
-from dolfinx_mortar.kinds import BasisKind, is_partition_of_unity
+from dolfinx_mortar.kinds import dual_partner
 from dolfinx_mortar.layout import MassMatrixSolver, NodeLayout, assemble_blocks
 
 FloatArray = npt.NDArray[np.float64]
@@ -90,29 +90,19 @@ def lumped_slave_part(blocks: FloatArray, slave_nodes: int) -> FloatArray:
 
 def dual_slip_blocks(source) -> tuple:
     """LmLS, LmLS* against an elastic master: ``source.pair_operators`` with the
-    scalar couplings ``[D̄ | −M̄]`` of the dual basis of the same ``∫ M̄_A``
-    (LcLS* for LmLS*, LcLS for LmLS).
+    scalar couplings ``[D̄ | −M̄]`` of the dual basis of the same ``∫ M̄_A``.
 
-    Their own ``D̄_AB = ∫ M̄_A N_B`` is a row-scaled consistent mass, and the
-    nodal Coulomb conditions on such averages of the neighbours' slips made
-    Newton's stick/slip iteration run away (a block pushed sideways at 0.2 of
-    its load, μ = 0.3: the slipping zone's slip reversed from one iteration
-    to the next and every increment stalled). Lumping ``D̄`` onto the
-    diagonal beside the mortar ``M̄`` (until 2026-12-08) converged, but read a
-    motion both sides share as slip wherever it was not uniform, ``(W − D̄)u``:
-    two blocks widening alike under a uniform pressure put the node at their
-    held edge on the Coulomb cone and moved the pressure by 3.7%. Taking the
-    master at the node's projection instead is no slip for shared motions,
-    but does not pass a uniform traction on to a non-matching master. The
-    dual basis does both (biorthogonality: ``D̄`` diagonal where a facet is
-    covered), as for the dual kinds themselves (docs/FRICTION.md, §The slip of
-    LmLS and LmLS*).
+    Their own ``D̄`` (a row-scaled consistent mass) sets each node's Coulomb
+    condition on an average of its neighbours' slips, on which Newton ran
+    away; lumping it beside the mortar ``M̄`` (until 2026-12-08) read a shared,
+    non-uniform motion as slip, ``(W − D̄)u`` (3.7% on the pressure of two
+    blocks widening alike). The dual basis keeps ``D̄`` diagonal where a facet
+    is covered, sees no slip in a shared motion and passes a uniform traction
+    on (docs/FRICTION.md, §The slip of LmLS and LmLS*).
     """
     coupling = source.coupling
-    dual = BasisKind.LcLS_star if is_partition_of_unity(source.basis.kind) else BasisKind.LcLS
-    C = coupling.basis(dual).coefficients
-    T = source.slave.reference.transform
-    C = (C if T is None else np.einsum("ab,cbd->cad", T, C))[coupling.pairs[:, 0]]
+    C = coupling.basis(dual_partner(source.basis.kind)).coefficients
+    C = source.slave.reference.standard_coefficients(C)[coupling.pairs[:, 0]]
     Dn, Mn, _ = coupling.raw_pairs
     cells, cols, _ = source.pair_operators
     return cells, cols, np.concatenate([np.einsum("pba,pbc->pac", C, Dn),
